@@ -1,0 +1,31 @@
+# hdwf: the lost-motion study of harmonic drives, from design of experiments to a PDF report.
+# Targets: `paper` (the statistics chain on the paper's Tables 4/5) -> results/paper/report.pdf.
+# Rules live in workflow/rules/*.smk; scripts in workflow/scripts/ are thin adapters over the
+# installed `hdwf` package (pip install -e .).
+
+from pathlib import Path
+
+from hdwf.config import validate_config
+
+configfile: "config.yaml"
+
+# Fail at start-up, naming the key, before any job runs.
+validate_config(config, Path(workflow.basedir) / "workflow/schemas/config.schema.yaml",
+                source=(workflow.overwrite_configfiles or ["config.yaml"])[-1])
+
+include: "workflow/rules/common.smk"
+include: "workflow/rules/doe.smk"
+include: "workflow/rules/paper.smk"
+include: "workflow/rules/stats.smk"
+include: "workflow/rules/report.smk"
+
+
+rule all:
+    default_target: True
+    input:
+        "results/paper/report.pdf",
+
+
+rule paper:
+    input:
+        "results/paper/report.pdf",

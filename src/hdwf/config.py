@@ -1,0 +1,74 @@
+"""Load and validate the study configuration against its JSON schema.
+
+Snakemake's own ``validate`` reports jsonschema's raw message; we re-word it so the user
+reads the file, the dotted key path, the value and what was expected.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+
+import jsonschema
+import yaml
+
+from .errors import ConfigError
+
+
+def _key_path(error: jsonschema.ValidationError) -> str:
+    return ".".join(str(p) for p in error.absolute_path) or "(top level)"
+
+
+def validate_config(config: dict, schema_path: str | Path, source: str | Path = "config.yaml") -> dict:
+    """Validate ``config`` in place, filling schema defaults; raise ConfigError on the first problem.
+
+    Every problem found is listed in the message, worst (shallowest) first.
+    """
+    schema = yaml.safe_load(Path(schema_path).read_text())
+    validator_cls = jsonschema.validators.validator_for(schema)
+    # Fill defaults so downstream code never meets a missing optional key.
+    def set_defaults(validator, properties, instance, schema_):
+        if isinstance(instance, dict):
+            for key, sub in properties.items():
+                if isinstance(sub, dict) and "default" in sub:
+                    instance.setdefault(key, json.loads(json.dumps(sub["default"])))
+        yield from validator_cls.VALIDATORS["properties"](validator, properties, instance, schema_)
+
+    extended = jsonschema.validators.extend(validator_cls, {"properties": set_defaults})
+    errors = sorted(extended(schema).iter_errors(config), key=lambda e: (len(e.absolute_path), str(e.absolute_path)))
+    if errors:
+        first = errors[0]
+        others = "" if len(errors) == 1 else f" (and {len(errors) - 1} more problem(s): " + "; ".join(
+            f"{_key_path(e)}: {e.message}" for e in errors[1:4]) + ")"
+        value = first.instance if not isinstance(first.instance, (dict, list)) else None
+        raise ConfigError(source, f"{first.message}{others}", field=_key_path(first), value=value)
+    _check_relations(config, source)
+    return config
+
+
+def _check_relations(config: dict, source) -> None:
+    """Rules a JSON schema cannot express."""
+    sob = config.get("sobol", {})
+    n_start = sob.get("n_start")
+    if n_start is not None and n_start & (n_start - 1):
+        raise ConfigError(source, "must be a power of two (Sobol' sequences need it)", field="sobol.n_start",
+                          value=n_start)
+    if n_start is not None and not n_start <= sob["n_min"] <= sob["n_max"]:
+        raise ConfigError(source, f"need n_start <= n_min <= n_max, got {n_start}, {sob['n_min']}, {sob['n_max']}",
+                          field="sobol.n_min", value=sob["n_min"])
+
+
+def load_config(path: str | Path, schema_path: str | Path) -> dict:
+    path = Path(path)
+    try:
+        config = yaml.safe_load(path.read_text()) or {}
+    except yaml.YAMLError as exc:
+        raise ConfigError(path, f"not valid YAML: {exc}") from exc
+    return validate_config(config, schema_path, path)
+
+
+def config_hash(config: dict) -> str:
+    """SHA-256 of the canonical JSON of a config: same config, same hash, whatever the key order."""
+    canonical = json.dumps(config, sort_keys=True, separators=(",", ":"), default=str)
+    return hashlib.sha256(canonical.encode()).hexdigest()

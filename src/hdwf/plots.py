@@ -1,0 +1,103 @@
+"""Figures of the study, in the paper's forms (Figs. 6–9, 13–14), written atomically as PNG."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+from scipy.optimize import isotonic_regression  # noqa: E402
+
+from . import PARAMETER_COLUMNS, PARAMETER_LABELS, PARAMETERS  # noqa: E402
+from .io import atomic_path  # noqa: E402
+
+_PNG_META = {"Software": None}  # no version string in the file: same data, same bytes
+
+
+def _save(fig, path):
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=150, format="png", metadata=_PNG_META, bbox_inches="tight")
+    plt.close(fig)
+
+
+def _label(p):
+    return f"${PARAMETER_LABELS[p].replace('_', '_{') + ('}' if '_' in PARAMETER_LABELS[p] else '')}$ (mm)"
+
+
+def correlation_figure(designs: pd.DataFrame, corr: pd.DataFrame, title: str, path) -> None:
+    """Φ against each input with the Pearson line and a monotone (rank) trend, as Figs. 6/7."""
+    y = designs["lost_motion_arcmin"].to_numpy(float)
+    fig, axes = plt.subplots(1, 5, figsize=(15, 3.2), sharey=True)
+    for ax, p, col in zip(axes, PARAMETERS, PARAMETER_COLUMNS):
+        x = designs[col].to_numpy(float)
+        ok = np.isfinite(y)
+        ax.plot(x[ok], y[ok], "o", mfc="none", color="tab:blue", label="Φ")
+        slope, icpt = np.polyfit(x[ok], y[ok], 1)
+        xs = np.linspace(x.min(), x.max(), 50)
+        ax.plot(xs, icpt + slope * xs, "-", color="tab:red", label="Pearson (linear)")
+        # Spearman measures a monotone relation: draw the best monotone (isotonic) fit.
+        rho = float(corr.set_index("parameter").loc[p, "spearman_rho"])
+        order = np.argsort(x[ok])
+        mono = isotonic_regression(y[ok][order], increasing=rho >= 0).x
+        ax.plot(x[ok][order], mono, "-", color="black", lw=1, label="Spearman (monotone fit)")
+        r = float(corr.set_index("parameter").loc[p, "pearson_r"])
+        ax.set_title(f"r = {r:.3f}, ρ = {rho:.3f}", fontsize=9)
+        ax.set_xlabel(_label(p))
+        ax.ticklabel_format(axis="x", useOffset=False)
+        ax.tick_params(axis="x", labelrotation=30, labelsize=7)
+    axes[0].set_ylabel("lost motion Φ (arcmin)")
+    axes[0].legend(fontsize=7)
+    fig.suptitle(title)
+    _save(fig, path)
+
+
+def surrogate_figure(designs: pd.DataFrame, fitted: np.ndarray, title: str, path) -> None:
+    """Data (circles) and surrogate (asterisks) against each input, as Figs. 8/9, plus a parity plot."""
+    y = designs["lost_motion_arcmin"].to_numpy(float)
+    fig, axes = plt.subplots(1, 6, figsize=(17, 3.2))
+    for ax, p, col in zip(axes, PARAMETERS, PARAMETER_COLUMNS):
+        x = designs[col].to_numpy(float)
+        ax.plot(x, y, "o", mfc="none", color="tab:blue", label="data")
+        ax.plot(x, fitted, "*", color="tab:red", label="quadratic")
+        ax.set_xlabel(_label(p))
+        ax.ticklabel_format(axis="x", useOffset=False)
+        ax.tick_params(axis="x", labelrotation=30, labelsize=7)
+    axes[0].set_ylabel("Φ (arcmin)")
+    axes[0].legend(fontsize=7)
+    ax = axes[5]
+    lim = [min(y.min(), fitted.min()), max(y.max(), fitted.max())]
+    ax.plot(lim, lim, "-", color="grey", lw=0.8)
+    ax.plot(y, fitted, "o", color="tab:purple", ms=4)
+    ax.set_xlabel("data Φ (arcmin)")
+    ax.set_ylabel("surrogate Φ (arcmin)")
+    ax.set_title("parity", fontsize=9)
+    fig.suptitle(title)
+    _save(fig, path)
+
+
+def sobol_convergence_figure(sobol: pd.DataFrame, title: str, path) -> None:
+    """S1 (left) and ST (right) against N for each sampler, exact values dashed, as Figs. 13/14."""
+    exact = sobol[sobol["sampler"] == "exact"].set_index("parameter")
+    est = sobol[sobol["sampler"] != "exact"]
+    styles = {"lhs": ":", "halton": "--", "sobol": "-"}
+    colors = dict(zip(PARAMETERS, ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple"]))
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4), sharey=True)
+    for ax, idx in zip(axes, ["S1", "ST"]):
+        for p in PARAMETERS:
+            for sampler, sub in est[est["parameter"] == p].groupby("sampler"):
+                ax.plot(sub["n"], sub[idx], styles.get(sampler, "-"), color=colors[p], lw=1,
+                        marker="o" if sampler == "sobol" else None, ms=2.5,
+                        label=f"{PARAMETER_LABELS[p]} ({sampler})" if idx == "S1" else None)
+            ax.axhline(exact.loc[p, idx], color=colors[p], lw=2.0, alpha=0.35)
+        ax.set_xscale("log", base=2)
+        ax.set_xlabel("base sample size N")
+        ax.set_title({"S1": "first order $S_i$", "ST": "total effect $S_{Ti}$"}[idx] + " (thick: exact)")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("index")
+    axes[0].legend(fontsize=6, ncol=3)
+    fig.suptitle(title)
+    _save(fig, path)

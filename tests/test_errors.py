@@ -1,0 +1,88 @@
+"""Bad input is refused with a message naming file, field (and row, value)."""
+
+import shutil
+
+import pytest
+import yaml
+
+from hdwf.config import load_config
+from hdwf.errors import ConfigError, InputError
+from hdwf.paper import load_fea_designs
+
+from conftest import ROOT
+
+SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
+
+
+def _config_with(tmp_path, edit):
+    config = yaml.safe_load((ROOT / "config.yaml").read_text())
+    edit(config)
+    path = tmp_path / "my-config.yaml"
+    path.write_text(yaml.safe_dump(config))
+    return path
+
+
+def test_shipped_config_is_valid():
+    config = load_config(ROOT / "config.yaml", SCHEMA)
+    assert config["sobol"]["n_min"] == 65536
+
+
+@pytest.mark.parametrize("edit, field, value", [
+    (lambda c: c["doe"].update(n_designs="many"), "doe.n_designs", "many"),            # wrong type
+    (lambda c: c["doe"].update(n_designs=5), "doe.n_designs", 5),                      # below 22
+    (lambda c: c["sobol"].update(tolerance=-0.1), "sobol.tolerance", -0.1),            # out of range
+    (lambda c: c["sobol"].update(samplers=["monte-carlo"]), "sobol.samplers.0", "monte-carlo"),
+    (lambda c: c["studies"]["paper"].update(units=["hd50"]), "studies.paper.units.0", "hd50"),
+    (lambda c: c["sobol"].update(n_start=100), "sobol.n_start", 100),                  # not a power of two
+])
+def test_bad_config_names_file_field_and_value(tmp_path, edit, field, value):
+    path = _config_with(tmp_path, edit)
+    with pytest.raises(ConfigError) as exc:
+        load_config(path, SCHEMA)
+    msg = str(exc.value)
+    assert "my-config.yaml" in msg and f"field '{field}'" in msg and repr(value) in msg
+
+
+def test_unknown_key_is_refused(tmp_path):
+    path = _config_with(tmp_path, lambda c: c["sobol"].update(tolerence=0.01))
+    with pytest.raises(ConfigError, match="tolerence"):
+        load_config(path, SCHEMA)
+
+
+def _copy_tables(tmp_path):
+    dst = tmp_path / "paper"
+    shutil.copytree(ROOT / "data" / "paper", dst)
+    return dst
+
+
+def test_table_missing_column(tmp_path):
+    d = _copy_tables(tmp_path)
+    f = d / "table4_hd42_fea.csv"
+    f.write_text(f.read_text().replace("rCS_mm", "r_CS"))
+    with pytest.raises(InputError) as exc:
+        load_fea_designs(d, "hd42")
+    assert "table4_hd42_fea.csv" in str(exc.value) and "field 'rCS_mm'" in str(exc.value)
+
+
+def test_table_non_numeric_value(tmp_path):
+    d = _copy_tables(tmp_path)
+    f = d / "table4_hd42_fea.csv"
+    lines = f.read_text().splitlines()
+    lines[5] = lines[5].replace("0.1993212189", "0.19x")  # data row 5 = set 5
+    f.write_text("\n".join(lines) + "\n")
+    with pytest.raises(InputError) as exc:
+        load_fea_designs(d, "hd42")
+    msg = str(exc.value)
+    assert "table4_hd42_fea.csv" in msg and "row 5" in msg and "field 'lost_motion_arcmin'" in msg and "'0.19x'" in msg
+
+
+def test_table_empty_cell(tmp_path):
+    d = _copy_tables(tmp_path)
+    f = d / "table5_hd120_fea.csv"
+    lines = f.read_text().splitlines()
+    cells = lines[2].split(",")
+    cells[3] = ""
+    lines[2] = ",".join(cells)
+    f.write_text("\n".join(lines) + "\n")
+    with pytest.raises(InputError, match=r"row 2, field 'Gr_mm'"):
+        load_fea_designs(d, "hd120")

@@ -1,0 +1,54 @@
+"""Artefacts: atomic writes, units and provenance in the Parquet metadata."""
+
+import pandas as pd
+import pyarrow.parquet as pq
+import pytest
+
+from hdwf.aggregate import paper_lost_motion_stage, write_lost_motion
+from hdwf.config import config_hash
+from hdwf.io import atomic_path, read_parquet_meta
+from hdwf.provenance import provenance
+
+from conftest import ROOT
+
+
+def test_failed_write_leaves_previous_file_intact(tmp_path):
+    target = tmp_path / "result.json"
+    target.write_text("earlier result")
+    with pytest.raises(RuntimeError):
+        with atomic_path(target) as tmp:
+            tmp.write_text("half")
+            raise RuntimeError("killed mid-write")
+    assert target.read_text() == "earlier result"
+    assert [p.name for p in tmp_path.iterdir()] == ["result.json"]  # no temporary left behind
+
+
+def test_config_hash_ignores_key_order():
+    assert config_hash({"a": 1, "b": {"c": 2, "d": 3}}) == config_hash({"b": {"d": 3, "c": 2}, "a": 1})
+    assert config_hash({"a": 1}) != config_hash({"a": 2})
+
+
+def test_lost_motion_schema_units_and_provenance(tmp_path, paper_dir):
+    prov = provenance({"x": 1}, ROOT)
+    out = paper_lost_motion_stage(paper_dir, "hd42", tmp_path / "lm.parquet", prov)
+    schema = pq.read_schema(out)
+    assert schema.names[:10] == ["design_id", "d_mm", "D_mm", "Gr_mm", "rFS_mm", "rCS_mm", "phi_plus_arcmin",
+                                 "phi_minus_arcmin", "lost_motion_arcmin", "status"]
+    assert schema.field("lost_motion_arcmin").metadata[b"unit"] == b"arcmin"
+    assert schema.field("d_mm").metadata[b"unit"] == b"mm"
+    stored, _ = read_parquet_meta(out)
+    assert stored["config_hash"] == config_hash({"x": 1})
+    assert stored["packages"]["numpy"] and stored["git_commit"]
+    df = pd.read_parquet(out)
+    assert df["phi_plus_arcmin"].isna().all()  # the paper gives only Φ
+    assert (df["status"] == "published").all()
+
+
+def test_failed_design_never_carries_a_number(tmp_path):
+    df = pd.DataFrame({"design_id": ["a", "b"], "d_mm": [31.0, 31.0], "D_mm": [42.0, 42.0], "Gr_mm": [0.01, 0.01],
+                       "rFS_mm": [0.0, 0.0], "rCS_mm": [0.0, 0.0], "lost_motion_arcmin": [0.5, 0.7],
+                       "status": ["ok", "failed: contact did not converge in 50 iterations"]})
+    out = write_lost_motion(df, tmp_path / "lm.parquet", provenance={})
+    back = pd.read_parquet(out).set_index("design_id")
+    assert back.loc["a", "lost_motion_arcmin"] == 0.5
+    assert pd.isna(back.loc["b", "lost_motion_arcmin"])

@@ -1,0 +1,91 @@
+"""Sobol' indices: exact values of known decompositions, numerical integration, SALib estimates."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hdwf import PARAMETER_COLUMNS, PARAMETERS
+from hdwf.paper import load_fea_designs, load_published
+from hdwf.sobol import convergence, estimate_indices, exact_indices, exact_quadratic_indices, radial_matrix
+from hdwf.surrogate import fit_quadratic
+
+
+def test_additive_linear_function():
+    # f = u1 + u2: equal variances, no interaction.
+    s1, st = exact_quadratic_indices([1, 1], [0, 0], np.zeros((2, 2)))
+    assert s1 == pytest.approx([0.5, 0.5]) and st == pytest.approx([0.5, 0.5])
+
+
+def test_pure_interaction():
+    # f = u1 u2: no main effect at all, every variance is interaction.
+    s1, st = exact_quadratic_indices([0, 0], [0, 0], [[0, 1], [0, 0]])
+    assert s1 == pytest.approx([0, 0]) and st == pytest.approx([1, 1])
+
+
+def test_mixed_by_hand():
+    # f = u1 + u2^2 + u1 u3: V1 = 1/3, V2 = 4/45, V13 = 1/9; V = 1/3 + 4/45 + 1/9 = 24/45.
+    s1, st = exact_quadratic_indices([1, 0, 0], [0, 1, 0], [[0, 0, 1], [0, 0, 0], [0, 0, 0]])
+    assert s1 == pytest.approx([15 / 24, 4 / 24, 0])
+    assert st == pytest.approx([20 / 24, 4 / 24, 5 / 24])
+
+
+def test_exact_agrees_with_gauss_legendre_integration():
+    """S_i = Var(E[f | u_i]) / Var(f) computed on a tensor Gauss-Legendre grid (exact for quadratics)."""
+    rng = np.random.default_rng(7)
+    a, q, r = rng.normal(size=3), rng.normal(size=3), np.triu(rng.normal(size=(3, 3)), 1)
+    nodes, weights = np.polynomial.legendre.leggauss(3)
+    weights = weights / 2
+    U = np.array(np.meshgrid(nodes, nodes, nodes, indexing="ij"))
+    W = np.einsum("i,j,k->ijk", weights, weights, weights)
+    f = sum(a[i] * U[i] + q[i] * U[i] ** 2 for i in range(3)) + sum(r[i, j] * U[i] * U[j] for i in range(3)
+                                                                      for j in range(i + 1, 3))
+    mean = np.sum(W * f)
+    var = np.sum(W * (f - mean) ** 2)
+    s1, _ = exact_quadratic_indices(a, q, r)
+    for i in range(3):
+        other = tuple(k for k in range(3) if k != i)
+        cond = np.sum(W * f, axis=other) / np.sum(W, axis=other)  # E[f | u_i] at the nodes
+        assert np.sum(weights * (cond - mean) ** 2) / var == pytest.approx(s1[i], rel=1e-10)
+
+
+def test_radial_matrix_order():
+    base = np.arange(2 * 4, dtype=float).reshape(2, 4)  # two points, k = 2
+    m = radial_matrix(base)
+    assert m.tolist() == [[0, 1], [2, 1], [0, 3], [2, 3], [4, 5], [6, 5], [4, 7], [6, 7]]
+
+
+def _paper_model(paper_dir, unit):
+    df = load_fea_designs(paper_dir, unit)
+    X = df[list(PARAMETER_COLUMNS)].to_numpy()
+    return fit_quadratic(X, df["lost_motion_arcmin"].to_numpy(), X.min(0), X.max(0), "design_range")
+
+
+@pytest.mark.parametrize("unit", ["hd42", "hd120"])
+def test_sobol_sequence_estimate_at_65536_matches_exact(paper_dir, unit):
+    model = _paper_model(paper_dir, unit)
+    exact = exact_indices(model).set_index("parameter")
+    est = estimate_indices(model.predict_unit, model.parameters, "sobol", 65536, seed=4242 + 16,
+                           num_resamples=20).set_index("parameter")
+    for idx in ("S1", "ST"):
+        assert np.abs(est[idx] - exact[idx]).max() < 0.005
+
+
+@pytest.mark.parametrize("unit", ["hd42", "hd120"])
+def test_paper_indices_reproduced(paper_dir, unit):
+    exact = exact_indices(_paper_model(paper_dir, unit)).set_index("parameter")
+    # rFS and rCS carry the two largest total effects, as the paper finds.
+    assert set(exact["ST"].nlargest(2).index) == {"rFS", "rCS"}
+    pub = load_published(paper_dir)
+    for r in pub[(pub.unit == unit) & pub.statistic.str.startswith("sobol")].itertuples():
+        assert abs(exact.loc[r.parameter, r.statistic.split("_")[1]] - r.value) < 0.07, (r.parameter, r.statistic)
+
+
+def test_convergence_stops_at_tolerance_and_reports_failure():
+    f = lambda U: U[:, 0] + 2 * U[:, 1] + U[:, 0] * U[:, 2]  # noqa: E731
+    table, status = convergence(f, ["a", "b", "c"], "sobol", n_start=64, n_min=256, n_max=8192,
+                                tolerance=0.01, seed=1, num_resamples=20)
+    assert status["converged"] and status["n_converged"] >= 256
+    assert table["n"].max() == status["n_converged"]
+    _, status = convergence(f, ["a", "b", "c"], "lhs", n_start=64, n_min=64, n_max=128, tolerance=1e-9,
+                            seed=1, num_resamples=20)
+    assert not status["converged"] and "not reached" in status["reason"]

@@ -1,0 +1,16 @@
+# Our own optimal space-filling Latin hypercube per drive (Table 3 bounds).
+
+rule doe:
+    input:
+        bounds=f"{config['paper_data']}/table3_bounds.csv",
+    output:
+        "results/doe/{unit}/designs.parquet",
+    params:
+        n=config["doe"]["n_designs"],
+        seed=config["doe"]["seed"],
+        optimization=config["doe"]["optimization"],
+        repo=REPO_DIR,
+    log:
+        "results/logs/doe_{unit}.log",
+    script:
+        "../scripts/doe.py"

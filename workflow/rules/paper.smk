@@ -1,0 +1,16 @@
+# The paper's Tables 4/5 as the lost-motion table of a `source: paper` study.
+
+rule paper_lost_motion:
+    input:
+        table=lambda w: f"{config['paper_data']}/" + {"hd42": "table4_hd42_fea.csv", "hd120": "table5_hd120_fea.csv"}[w.unit],
+    output:
+        "results/{study}/{unit}/lost_motion.parquet",
+    wildcard_constraints:
+        study=_alternatives(PAPER_STUDIES),
+    params:
+        data_dir=config["paper_data"],
+        repo=REPO_DIR,
+    log:
+        "results/logs/{study}_{unit}_lost_motion.log",
+    script:
+        "../scripts/paper_lost_motion.py"

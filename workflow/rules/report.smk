@@ -1,0 +1,38 @@
+# The study's PDF report, typeset with typst from the artefacts only.
+
+# Per-drive artefacts the report reads, keyed as hdwf.report expects them ("<unit>__<key>").
+REPORT_ARTEFACTS = {
+    "lost_motion": "lost_motion.parquet",
+    "correlation": "correlation.parquet",
+    "correlation_png": "correlation.png",
+    "surrogate": "surrogate.json",
+    "surrogate_png": "surrogate.png",
+    "sobol": "sobol.parquet",
+    "sobol_png": "sobol_convergence.png",
+}
+
+
+def report_inputs(wildcards):
+    units = study_units(wildcards.study)
+    files = {}
+    for unit in units:
+        for key, name in REPORT_ARTEFACTS.items():
+            files[f"{unit}__{key}"] = f"results/{wildcards.study}/{unit}/{name}"
+        files[f"{unit}__doe"] = f"results/doe/{unit}/designs.parquet"
+    return files
+
+
+rule study_report:
+    input:
+        unpack(report_inputs),
+    output:
+        "results/{study}/report.pdf",
+    params:
+        units=lambda w: study_units(w.study),
+        study_config=lambda w: STUDIES[w.study],
+        data_dir=config["paper_data"],
+        repo=REPO_DIR,
+    log:
+        "results/logs/{study}_report.log",
+    script:
+        "../scripts/report.py"
