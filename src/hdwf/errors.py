@@ -11,6 +11,10 @@ class InputError(ValueError):
     """
 
     def __init__(self, file, problem, *, row=None, field=None, value=None):
+        if hasattr(value, "item"):  # numpy scalars print as np.float64(...): show the plain number
+            value = value.item()
+        if hasattr(row, "item"):
+            row = row.item()
         self.file, self.problem, self.row, self.field, self.value = str(file), problem, row, field, value
         where = [f"{self.file}"]
         if row is not None:
