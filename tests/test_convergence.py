@@ -1,0 +1,38 @@
+"""The grid convergence index against functions with a known error term."""
+
+import math
+
+import pytest
+
+from hdwf.convergence import gci
+
+
+@pytest.mark.parametrize("order", [1.0, 2.0, 1.5])
+def test_recovers_order_and_exact_value(order):
+    exact, c = 1.3, 0.4
+    h = (0.5, 1.0, 2.0)
+    res = gci(h, tuple(exact + c * hi ** order for hi in h))
+    assert res.monotone
+    assert res.p == pytest.approx(order, rel=1e-8)
+    assert res.phi_extrapolated == pytest.approx(exact, rel=1e-10)
+    # GCI = 1.25 |e21/phi1| / (r^p - 1), and the true error lies inside it (safety factor 1.25).
+    f1 = exact + c * 0.5 ** order
+    assert res.gci_fine == pytest.approx(1.25 * abs((c * (1 - 0.5 ** order)) / f1) / (2 ** order - 1), rel=1e-8)
+    assert abs(f1 - exact) / f1 < res.gci_fine
+
+
+def test_non_uniform_refinement_ratio():
+    exact, h = 2.0, (0.3, 0.5, 1.1)
+    res = gci(h, tuple(exact - 0.7 * hi ** 2 for hi in h))
+    assert res.p == pytest.approx(2.0, rel=1e-6) and res.phi_extrapolated == pytest.approx(exact, rel=1e-8)
+
+
+def test_oscillation_is_flagged():
+    res = gci((0.5, 1.0, 2.0), (1.00, 1.02, 0.99))
+    assert not res.monotone and math.isnan(res.p)
+    assert res.gci_fine == pytest.approx(1.5 * 0.03 / 1.00)
+
+
+def test_sizes_must_be_ordered():
+    with pytest.raises(ValueError):
+        gci((1.0, 0.5, 2.0), (1, 1, 1))
