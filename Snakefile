@@ -1,5 +1,7 @@
 # hdwf: the lost-motion study of harmonic drives, from design of experiments to a PDF report.
-# Targets: `paper` (the statistics chain on the paper's Tables 4/5) -> results/paper/report.pdf.
+# Targets: default (`all`): every study through results/report.pdf (and the paper study's own PDF);
+# `paper`: the statistics chain on the paper's Tables 4/5 -> results/paper/report.pdf;
+# `fe_studies`: the FE studies' artefacts without the report.
 # Rules live in workflow/rules/*.smk; scripts in workflow/scripts/ are thin adapters over the
 # installed `hdwf` package (pip install -e .).
 
@@ -16,6 +18,7 @@ validate_config(config, Path(workflow.basedir) / "workflow/schemas/config.schema
 include: "workflow/rules/common.smk"
 include: "workflow/rules/doe.smk"
 include: "workflow/rules/paper.smk"
+include: "workflow/rules/fe.smk"
 include: "workflow/rules/stats.smk"
 include: "workflow/rules/report.smk"
 
@@ -23,9 +26,26 @@ include: "workflow/rules/report.smk"
 rule all:
     default_target: True
     input:
+        "results/report.pdf",
         "results/paper/report.pdf",
 
 
 rule paper:
     input:
         "results/paper/report.pdf",
+
+
+def fe_study_targets():
+    out = []
+    for study in FE_STUDIES:
+        for unit in study_units(study):
+            out += [f"results/{study}/{unit}/{name}" for name in
+                    ("lost_motion.parquet", "curves.parquet", "correlation.parquet", "surrogate.json", "sobol.parquet")]
+    conv = FE["convergence"]["study"]
+    out += [f"results/{conv}/{unit}/convergence.parquet" for unit in study_units(conv)]
+    return out
+
+
+rule fe_studies:
+    input:
+        fe_study_targets(),

@@ -49,6 +49,22 @@ def validate_config(config: dict, schema_path: str | Path, source: str | Path = 
 
 def _check_relations(config: dict, source) -> None:
     """Rules a JSON schema cannot express."""
+    fe = config.get("fe")
+    if fe is not None:
+        refs = fe["convergence"]["refinements"]
+        if fe["refinement"] not in refs:
+            raise ConfigError(source, f"must contain fe.refinement ({fe['refinement']}), the default mesh, as one of "
+                              "the three meshes", field="fe.convergence.refinements", value=refs)
+        if fe["refinement"] != max(refs):
+            raise ConfigError(source, "the default mesh must be the finest of the three (the study runs on it)",
+                              field="fe.refinement", value=fe["refinement"])
+        study = fe["convergence"]["study"]
+        if study not in config["studies"] or config["studies"][study]["source"] != "fe":
+            raise ConfigError(source, "must name an fe study", field="fe.convergence.study", value=study)
+    for name, study in config.get("studies", {}).items():
+        if study["source"] == "paper" and study.get("designs", "paper") != "paper":
+            raise ConfigError(source, "a paper study uses the paper's designs", field=f"studies.{name}.designs",
+                              value=study["designs"])
     sob = config.get("sobol", {})
     n_start = sob.get("n_start")
     if n_start is not None and n_start & (n_start - 1):

@@ -101,3 +101,39 @@ def sobol_convergence_figure(sobol: pd.DataFrame, title: str, path) -> None:
     axes[0].legend(fontsize=6, ncol=3)
     fig.suptitle(title)
     _save(fig, path)
+
+
+def curves_figure(curves: pd.DataFrame, lost_motion: pd.DataFrame, design_ids: list[str], title: str, path) -> None:
+    """Torque–twist curves of a few designs (the paper's Fig. 1 measured in our model)."""
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    lm = lost_motion.set_index("design_id")
+    for did in design_ids:
+        c = curves[curves["design_id"] == did].sort_values("step")
+        ax.plot(c["twist_arcmin"], c["torque_Nm"], "-o", ms=3,
+                label=f"{did}: Φ = {lm.loc[did, 'lost_motion_arcmin']:.3f} arcmin")
+    ax.axhline(0, color="grey", lw=0.5)
+    ax.axvline(0, color="grey", lw=0.5)
+    ax.set_xlabel("FS twist (arcmin)")
+    ax.set_ylabel("output torque (N·m)")
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    ax.set_title(title, fontsize=10)
+    _save(fig, path)
+
+
+def agreement_figure(pairs: dict[str, tuple[np.ndarray, np.ndarray]], title: str, path) -> None:
+    """Our Φ against the paper's Φ at the same design points, one panel per drive."""
+    fig, axes = plt.subplots(1, len(pairs), figsize=(5.2 * len(pairs), 4.2), squeeze=False)
+    for ax, (label, (paper, ours)) in zip(axes[0], pairs.items()):
+        ok = np.isfinite(ours)
+        ax.plot(paper[ok], ours[ok], "o", mfc="none")
+        slope, icpt = np.polyfit(paper[ok], ours[ok], 1)
+        xs = np.linspace(paper.min(), paper.max(), 20)
+        ax.plot(xs, icpt + slope * xs, "-", color="tab:red", lw=1, label=f"fit: ours = {slope:.2f}·paper + {icpt:.2f}")
+        ax.set_xlabel("paper's Ansys FEA Φ (arcmin)")
+        ax.set_ylabel("hdwf FE Φ (arcmin)")
+        ax.set_title(label, fontsize=10)
+        ax.legend(fontsize=7)
+        ax.grid(alpha=0.3)
+    fig.suptitle(title)
+    _save(fig, path)

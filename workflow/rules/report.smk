@@ -36,3 +36,32 @@ rule study_report:
         "results/logs/{study}_report.log",
     script:
         "../scripts/report.py"
+
+
+def full_report_inputs(wildcards):
+    files = {}
+    for study in STUDIES:
+        for unit in study_units(study):
+            for key, name in REPORT_ARTEFACTS.items():
+                files[f"{study}__{unit}__{key}"] = f"results/{study}/{unit}/{name}"
+            files[f"{study}__{unit}__doe"] = f"results/doe/{unit}/designs.parquet"
+            if STUDIES[study]["source"] == "fe":
+                files[f"{study}__{unit}__curves"] = f"results/{study}/{unit}/curves.parquet"
+            if study == FE["convergence"]["study"]:
+                files[f"{study}__{unit}__convergence"] = f"results/{study}/{unit}/convergence.parquet"
+    return files
+
+
+rule full_report:
+    input:
+        unpack(full_report_inputs),
+    output:
+        "results/report.pdf",
+    params:
+        studies=STUDIES,
+        data_dir=config["paper_data"],
+        repo=REPO_DIR,
+    log:
+        "results/logs/report.log",
+    script:
+        "../scripts/full_report.py"

@@ -1,0 +1,61 @@
+"""Time one HD 42 design (Table 4, set 8) at the default mesh: median of 3 solves.
+
+Run with one thread, e.g.  OMP_NUM_THREADS=1 python benchmarks/bench_solve.py
+Prints mesh time, solve_s, factorize_s (one factorisation of every body's stiffness),
+their ratio, Phi and the peak resident memory of the process (resource.getrusage).
+"""
+
+from __future__ import annotations
+
+import os
+import resource
+import statistics
+import sys
+import time
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("MKL_NUM_THREADS", "1")
+try:
+    import hdwf  # noqa: F401
+except ImportError:
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
+
+from hdwf.fe import solve_lost_motion  # noqa: E402
+from hdwf.geometry import drive_geometry  # noqa: E402
+from hdwf.mesh import build_mesh  # noqa: E402
+
+
+def main(repeats: int = 3, refinement: float = 1.0) -> None:
+    g = drive_geometry("hd42", 31.0151111111, 41.992, 0.0152777778, 0.0144444444,
+                       0.0188888889)
+    t0 = time.perf_counter()
+    mesh = build_mesh(g, refinement=refinement)
+    mesh_s = time.perf_counter() - t0
+    runs = []
+    for _ in range(repeats):
+        r = solve_lost_motion(g, mesh, steps_per_ramp=5)
+        if r.status != "ok":
+            print(f"FAILED: {r.reason}")
+            sys.exit(1)
+        runs.append(r)
+    solve = statistics.median(r.solve_s for r in runs)
+    fact = statistics.median(r.factorize_s for r in runs)
+    peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    r = runs[0]
+    print(f"design            HD 42 Table 4 set 8 (paper Phi 1.487 arcmin)")
+    print(f"nodes / dofs      {mesh.n_nodes} / {r.n_dofs}")
+    print(f"mesh_s            {mesh_s:.2f}")
+    print(f"solve_s (median)  {solve:.2f}   (includes assembly + factorisation)")
+    print(f"factorize_s       {fact:.2f}")
+    print(f"ratio             {solve / fact:.1f}")
+    print(f"peak memory       {peak_mb:.0f} MB")
+    print(f"Phi               {r.lost_motion_arcmin:.4f} arcmin (phi {r.phi_plus_arcmin:.4f}, "
+          f"phi' {r.phi_minus_arcmin:.4f})")
+    print(f"teeth in contact  {r.teeth_in_contact}, max penetration "
+          f"{r.max_penetration_um:.4f} um, iterations {r.iterations}")
+
+
+if __name__ == "__main__":
+    main(refinement=float(sys.argv[1]) if len(sys.argv) > 1 else 1.0)

@@ -1,0 +1,49 @@
+"""Throughput of per-design FE solves with 1 and with 2 Snakemake jobs at once.
+
+Meshes the first N designs of the `fe_at_paper` HD 42 study once, then times the solve
+jobs alone (forced reruns), first with --cores 1, then with --cores 2, each R times,
+in a temporary copy of the workflow. Prints medians and the speed-up.
+Usage: .venv/bin/python benchmarks/bench_throughput.py [--designs 6] [--repeats 3]
+"""
+
+import argparse
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--designs", type=int, default=6)
+    parser.add_argument("--repeats", type=int, default=3)
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory(prefix="hdwf-bench-") as tmp:
+        tmp = Path(tmp)
+        for item in ("Snakefile", "config.yaml", "workflow", "data"):
+            src = ROOT / item
+            (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp / item)
+        targets = [f"results/fe_at_paper/hd42/designs/paper-{i:02d}.parquet" for i in range(1, args.designs + 1)]
+        meshes = [t.replace("/designs/", "/mesh/").replace(".parquet", ".npz") for t in targets]
+        subprocess.run([SNAKEMAKE, "--cores", "2", "--quiet", *meshes], cwd=tmp, check=True)
+        times = {1: [], 2: []}
+        for _ in range(args.repeats):
+            for cores in (1, 2):
+                t0 = time.perf_counter()
+                subprocess.run([SNAKEMAKE, "--cores", str(cores), "--quiet", "--forcerun", "fe_solve", *targets],
+                               cwd=tmp, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                times[cores].append(time.perf_counter() - t0)
+    m1, m2 = statistics.median(times[1]), statistics.median(times[2])
+    print(f"{args.designs} HD 42 solves; runs (s): 1 job {times[1]}, 2 jobs {times[2]}")
+    print(f"median wall time: 1 job {m1:.1f} s, 2 jobs {m2:.1f} s")
+    print(f"throughput 2 jobs / 1 job: {m1 / m2:.2f}x")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,876 @@
+"""Plane-stress FE model of the lost-motion test and our own frictionless contact solver.
+
+Assembly (scikit-fem): each body (FS, CS, bearing inner ring IR, outer ring OR) is a
+separate linear-elastic plane-stress steel mesh (E = 210 GPa, nu = 0.3; thickness = the
+part's face width), P1 triangles.  Units mm, N, MPa.
+
+Bodies and supports
+-------------------
+* cam: rigid analytic curve of Eq. 3, locked (not meshed);
+* CS: every node of its outer rim is fixed (Dirichlet);
+* IR, OR, FS float on their contacts.  Their rigid modes are removed *without bias* the
+  FETI way: each floating stiffness is factorised with three DOFs pinned, and the rigid-body
+  amplitudes alpha are extra unknowns of the contact problem together with the equations
+  R^T (f + G^T p) = 0 (the pinned DOFs then carry no reaction).  The two exceptions are
+  exact by construction: the IR rotation is pinned (the ring is clamped on the cam; no
+  torque reaches it because ball forces are radial) and the OR rotation is pinned (a free
+  bearing ring: balls and the OR/FS interface act radially, so nothing can turn it and
+  its pinned DOF carries zero reaction).  In the wave-generator stage the FS rotation is
+  pinned as well (nothing but the teeth can hold it); in the torque stage it is free and
+  its amplitude is the twist.
+
+Contacts (unilateral, frictionless), rows of a gap operator g = g0 + G u >= 0:
+* cam - IR bore: node-to-rigid-curve, gap and normal re-evaluated at the deformed
+  configuration and re-linearised until the geometry update is below 1e-6 mm;
+* balls: discrete elements between raceway patches (radial), initial gap G_r / 2, and a
+  Hertz law delta = c P^(2/3) (exact elliptic-contact Hertz, both raceways in series)
+  added as a secant compliance to the diagonal; secant updated to convergence;
+* OR outer - FS bore: mortar-type bins (piecewise-constant pressure over 1 deg arcs;
+  average radial displacement of each side), initial gap (D_nom - D)/2 from the fit;
+* FS - CS flanks: node-to-segment (FS flank/tip nodes against CS boundary segments),
+  built at the wave-generator-deflected configuration (gaps evaluated at the deformed FS)
+  and linearised about it (small deformation on top of the deflected state).  At +-T
+  every pair is re-detected at the deformed state (nonlinear gap); if that finds more
+  than 0.05 um penetration (large twists slide the flanks), the pairs near contact are
+  re-paired and re-linearised about that state and the level is solved again
+  (``max_penetration_redetected_um`` reports the final check).
+
+Contact solver (hand-written, as asked): a dual Schur-complement / active-set method.
+Each body is factorised ONCE (scipy SuperLU).  For a contact pair i the compliance column
+x_i = K^-1 G_i^T is obtained by back-substitution only when the pair first enters the
+working set, and reused over all later iterations and load steps.  On the working set
+the small dense mixed LCP
+
+    g = g0 + G K^-1 f + C p + H alpha >= 0,  p >= 0,  p.g = 0,  H^T p = -R^T f,
+    C = G K^-1 G^T + diag(s_ball),  H = G R
+
+is solved exactly by a primal-dual active-set (PDAS) iteration: solve the KKT system of
+the current active set, drop pairs with tensile p, add every candidate with penetration,
+repeat until no pair has p < 0 and the largest penetration of all candidate pairs is
+< ``tol_gap`` (1e-5 mm = 0.01 um).  Candidates outside the working set are checked every
+iteration with the displacement on the contact DOFs, so no violated pair can be missed.
+A free rigid mode that is loaded but not yet held (the FS rotation under torque while the
+teeth are apart) is closed by adding the first pair that closes along that mode.
+Cost: one factorisation per body plus back-solves, a handful of dense KKT solves per
+load step.  A run that does not converge returns status "failed" with a reason.
+
+The frictionless FS is indifferent inside the backlash at zero torque; zero-torque steps
+use 1e-3 of the test torque in the direction of the last load (the state an
+infinitesimally small friction would leave), documented in the result.
+
+Load and twist: the torque is a body-force pattern f = T w_i (-y, x) / sum(w r^2) on the FS
+rim below the tooth roots (w_i = nodal areas), the 2D stand-in for the shear flow the cup
+brings in; the twist is the work-conjugate mean rotation q^T u of the same region (exact
+rigid rotation for a rigid motion).  Curve twists are relative to the first (+0) state.
+
+Approximations (known, small): P1 triangles (Phi moves by about +-0.5 % between 0.75x and
+1.5x the paper's density; the elastic part phi by about +-4 %); the fit bins compare the
+two surfaces at equal reference angles (their relative slide of ~10 um on a surface slope
+<= 0.017 shifts those gaps by < 0.2 um, the same for every design); ball 0 sits on the
+major axis (one sample of the WG angle); no friction, no cup torsion (see background).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.optimize import brentq
+from scipy.sparse.linalg import splu
+from scipy.spatial import cKDTree
+from scipy.special import ellipe, ellipk
+from skfem import Basis, ElementTriP1, ElementVector, asm
+from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+from .geometry import ARCMIN, DriveGeometry, cam_points
+from .mesh import BodyMesh, DriveMesh
+
+TOL_GAP = 1e-5          # mm: 0.01 um allowed penetration
+ZERO_TORQUE_BIAS = 1e-3  # fraction of the test torque used at the zero-torque steps
+RELIN_TOL = 5e-5         # mm: re-linearise tooth pairs at +-T above 0.05 um re-detected
+RELIN_NEAR = 5e-3        # mm: ... but only those pairs closer than this (the loaded flanks)
+
+
+# --------------------------------------------------------------------------------------
+# Elasticity
+# --------------------------------------------------------------------------------------
+def plane_stress_lame(E: float, nu: float) -> tuple[float, float]:
+    lam, mu = lame_parameters(E, nu)
+    return 2 * lam * mu / (lam + 2 * mu), mu
+
+
+def assemble_stiffness(body: BodyMesh, E: float, nu: float):
+    """Plane-stress stiffness (N/mm) of a body of thickness ``body.thickness``."""
+    basis = Basis(body.mesh, ElementVector(ElementTriP1()))
+    lam, mu = plane_stress_lame(E, nu)
+    K = asm(linear_elasticity(lam, mu), basis) * body.thickness
+    return K.tocsr(), basis
+
+
+def nodal_areas(mesh) -> np.ndarray:
+    p, t = mesh.p, mesh.t
+    a = 0.5 * np.abs((p[0, t[1]] - p[0, t[0]]) * (p[1, t[2]] - p[1, t[0]])
+                     - (p[0, t[2]] - p[0, t[0]]) * (p[1, t[1]] - p[1, t[0]]))
+    w = np.zeros(p.shape[1])
+    for k in range(3):
+        np.add.at(w, t[k], a / 3)
+    return w
+
+
+def edge_loads(mesh, edges: np.ndarray, traction) -> np.ndarray:
+    """Consistent P1 nodal forces (per unit thickness) of a traction function
+    ``traction(x, y) -> (tx, ty)`` on boundary edges, 2-point Gauss per edge."""
+    p = mesh.p
+    f = np.zeros((2, p.shape[1]))
+    xa, xb = p[:, edges[:, 0]], p[:, edges[:, 1]]
+    L = np.linalg.norm(xb - xa, axis=0)
+    for s in (0.5 - 0.5 / math.sqrt(3), 0.5 + 0.5 / math.sqrt(3)):
+        x = xa + s * (xb - xa)
+        tx, ty = traction(x[0], x[1])
+        for node, N in ((edges[:, 0], 1 - s), (edges[:, 1], s)):
+            np.add.at(f[0], node, 0.5 * L * N * tx)
+            np.add.at(f[1], node, 0.5 * L * N * ty)
+    return f
+
+
+def solve_linear(body: BodyMesh, E: float, nu: float, fixed_dofs: np.ndarray,
+                 f_nodal: np.ndarray) -> np.ndarray:
+    """Plain linear solve (verification helper); f_nodal is (2, nnodes); returns (2, n)."""
+    K, basis = assemble_stiffness(body, E, nu)
+    nd = basis.nodal_dofs
+    f = np.zeros(K.shape[0])
+    f[nd[0]], f[nd[1]] = f_nodal[0], f_nodal[1]
+    free = np.setdiff1d(np.arange(K.shape[0]), fixed_dofs)
+    u = np.zeros(K.shape[0])
+    u[free] = splu(K[free][:, free].tocsc()).solve(f[free])
+    return np.vstack([u[nd[0]], u[nd[1]]])
+
+
+# --------------------------------------------------------------------------------------
+# Hertz contact of a ball
+# --------------------------------------------------------------------------------------
+def hertz_point_contact(rho_x: float, rho_y: float, E: float, nu: float):
+    """Exact Hertz elliptical point contact between two bodies of the same steel.
+
+    rho_x, rho_y: sums of the principal curvatures (1/mm) of both bodies in the two
+    (aligned) principal planes.  Returns ``(c, k)`` with the approach delta = c P^(2/3)
+    (mm, N) and the ellipticity k = a/b.  Harris / Hamrock:  F(rho) =
+    ((k^2+1) E(e) - 2 K(e)) / ((k^2-1) E(e)), delta = K(e) [9/(2 E(e) R) (P/(pi k E'))^2]^(1/3),
+    1/R = rho_x + rho_y, E' = E/(1-nu^2), e^2 = 1 - 1/k^2.
+    """
+    Ep = E / (1 - nu ** 2)
+    R = 1.0 / (rho_x + rho_y)
+    Frho = abs(rho_x - rho_y) / (rho_x + rho_y)
+    if Frho < 1e-12:
+        k, Ke, Ee = 1.0, math.pi / 2, math.pi / 2
+    else:
+        def res(k):
+            m = 1 - 1 / k ** 2
+            return ((k ** 2 + 1) * ellipe(m) - 2 * ellipk(m)) / ((k ** 2 - 1) * ellipe(m)) - Frho
+        k = brentq(res, 1 + 1e-9, 1e4, xtol=1e-14)
+        m = 1 - 1 / k ** 2
+        Ke, Ee = float(ellipk(m)), float(ellipe(m))
+    c = Ke * (9.0 / (2 * Ee * R) / (math.pi * k * Ep) ** 2) ** (1.0 / 3.0)
+    return c, k
+
+
+def ball_compliance_coeff(g: DriveGeometry, E: float | None = None) -> float:
+    """c of delta = c P^(2/3) for one ball: inner + outer raceway contacts in series.
+
+    Ball radius dw/2; raceway radius in the rolling plane d1/2 (inner, convex) and D1/2
+    (outer, concave); groove radius f*dw (concave) across.
+    """
+    E = g.E if E is None else E
+    rb = g.ball_dia / 2
+    rg = g.groove_conf * g.ball_dia
+    ci, _ = hertz_point_contact(1 / rb + 1 / g.ir_race, 1 / rb - 1 / rg, E, g.nu)
+    co, _ = hertz_point_contact(1 / rb - 1 / g.or_race, 1 / rb - 1 / rg, E, g.nu)
+    return ci + co
+
+
+# --------------------------------------------------------------------------------------
+# Bodies
+# --------------------------------------------------------------------------------------
+@dataclass
+class _Body:
+    name: str
+    bm: BodyMesh
+    K: sp.csr_matrix
+    nd: np.ndarray                  # (2, nnodes) global-in-body dof numbers
+    free: np.ndarray
+    lu: object
+    modes: dict[str, np.ndarray]    # name -> full-body rigid mode vector
+    watch_nodes: np.ndarray         # body node ids whose dofs are watched
+    wofs: int = 0                   # offset of this body in the watch vector
+    wpos: np.ndarray | None = None  # node id -> position in watch vector (2 per node) or -1
+
+    @property
+    def x(self):
+        return self.bm.mesh.p
+
+
+def _pin_nodes(p: np.ndarray, boundary: np.ndarray, r_mid: float):
+    """Two interior nodes near (-r_mid, 0) and (r_mid, 0)."""
+    mask = np.ones(p.shape[1], bool)
+    mask[boundary] = False
+    idx = np.flatnonzero(mask)
+    a = idx[np.argmin((p[0, idx] + r_mid) ** 2 + p[1, idx] ** 2)]
+    b = idx[np.argmin((p[0, idx] - r_mid) ** 2 + p[1, idx] ** 2)]
+    return a, b
+
+
+def _make_body(name: str, bm: BodyMesh, E: float, nu: float, fixed_nodes=None,
+               watch_nodes=None) -> tuple[_Body, float]:
+    K, basis = assemble_stiffness(bm, E, nu)
+    nd = basis.nodal_dofs
+    p = bm.mesh.p
+    ndof = K.shape[0]
+    modes = {}
+    if fixed_nodes is not None:
+        fixed = np.concatenate([nd[0, fixed_nodes], nd[1, fixed_nodes]])
+    else:
+        bnd = np.concatenate(list(bm.node_sets.values()))
+        r = np.hypot(p[0], p[1])
+        a, b = _pin_nodes(p, bnd, 0.5 * (r.min() + r.max()))
+        fixed = np.array([nd[0, a], nd[1, a], nd[1, b]])
+        for mname, vx, vy in (("tx", np.ones_like(p[0]), np.zeros_like(p[0])),
+                              ("ty", np.zeros_like(p[0]), np.ones_like(p[0])),
+                              ("rot", -p[1], p[0])):
+            v = np.zeros(ndof)
+            v[nd[0]], v[nd[1]] = vx, vy
+            modes[mname] = v
+    free = np.setdiff1d(np.arange(ndof), fixed)
+    t0 = time.perf_counter()
+    lu = splu(K[free][:, free].tocsc(), permc_spec="COLAMD")
+    tf = time.perf_counter() - t0
+    wn = np.unique(np.asarray(watch_nodes, dtype=np.int64))
+    return _Body(name, bm, K, nd, free, lu, modes, wn), tf
+
+
+# --------------------------------------------------------------------------------------
+# Contact rows
+# --------------------------------------------------------------------------------------
+@dataclass
+class _Rows:
+    """A block of contact pairs: sparse rows over the watch vector + gap constants."""
+    kind: str
+    G: sp.csr_matrix                # (n, nwatch)
+    g0: np.ndarray                  # g = g0 + G u_watch
+    info: dict = field(default_factory=dict)
+
+
+def _radial_rows(body: _Body, nodes_per_row: list[np.ndarray], sign: float, nwatch: int):
+    """Rows averaging sign * (e_r . u) over node groups of one body."""
+    r, c, v = [], [], []
+    p = body.x
+    for i, nodes in enumerate(nodes_per_row):
+        w = sign / len(nodes)
+        th = np.arctan2(p[1, nodes], p[0, nodes])
+        for comp, cs in ((0, np.cos(th)), (1, np.sin(th))):
+            r.append(np.full(len(nodes), i))
+            c.append(body.wpos[comp, nodes])
+            v.append(w * cs)
+    return sp.csr_matrix((np.concatenate(v), (np.concatenate(r), np.concatenate(c))),
+                         shape=(len(nodes_per_row), nwatch))
+
+
+def _boundary_edge_normals(mesh, edges: np.ndarray) -> np.ndarray:
+    """Unit normals of boundary edges pointing OUT of the body's material."""
+    p = mesh.p
+    N = p.shape[1]
+    key_f = np.sort(mesh.facets, axis=0).astype(np.int64)   # int64: N^2 overflows int32
+    keys = key_f[0] * N + key_f[1]
+    order = np.argsort(keys)
+    e = np.sort(edges, axis=1).astype(np.int64)
+    want = e[:, 0] * N + e[:, 1]
+    loc = np.minimum(np.searchsorted(keys[order], want), keys.size - 1)
+    pos = order[loc]
+    if np.any(keys[pos] != want) or np.any(edges < 0):
+        raise ValueError("boundary edges of a contact group are not edges of the "
+                         "triangle mesh (gmsh mesh defect)")
+    tri = mesh.f2t[0, pos]
+    third = mesh.t[:, tri]
+    third = np.where((third != e[:, 0]) & (third != e[:, 1]), third, -1).max(axis=0)
+    d = p[:, edges[:, 1]] - p[:, edges[:, 0]]
+    n = np.vstack([d[1], -d[0]]) / np.linalg.norm(d, axis=0)
+    inward = np.einsum("ij,ij->j", n, p[:, third] - p[:, edges[:, 0]]) > 0
+    n[:, inward] *= -1
+    return n
+
+
+# --------------------------------------------------------------------------------------
+# Result
+# --------------------------------------------------------------------------------------
+@dataclass
+class LostMotionResult:
+    phi_plus_arcmin: float
+    phi_minus_arcmin: float
+    lost_motion_arcmin: float
+    step: np.ndarray
+    torque_Nm: np.ndarray
+    twist_arcmin: np.ndarray
+    teeth_in_contact: int
+    max_penetration_um: float
+    iterations: int
+    status: str
+    reason: str
+    solve_s: float
+    factorize_s: float
+    n_dofs: int = 0
+    wg_deflection_um: float = float("nan")   # FS bore radial displacement at major axis
+    max_penetration_redetected_um: float = float("nan")  # tooth pairs re-found at +-T
+    notes: str = ""
+
+    @property
+    def curve(self) -> dict[str, np.ndarray]:
+        return {"step": self.step, "torque_Nm": self.torque_Nm,
+                "twist_arcmin": self.twist_arcmin}
+
+
+class ContactFailure(RuntimeError):
+    pass
+
+
+# --------------------------------------------------------------------------------------
+# The solver
+# --------------------------------------------------------------------------------------
+class LostMotionModel:
+    """Holds the factorised bodies, contact rows and the working set."""
+
+    def __init__(self, geom: DriveGeometry, mesh: DriveMesh, E: float | None = None,
+                 max_iter: int = 200, tol_gap: float = TOL_GAP, zone_deg: float = 35.0,
+                 n_bins: int = 360):
+        self.g = geom
+        self.E = geom.E if E is None else E
+        self.max_iter, self.tol_gap = max_iter, tol_gap
+        self.iterations = 0
+        self.debug = False
+        self.add_min, self.add_frac = 5, 0.2
+        self.n_bins = n_bins
+        bms = mesh.bodies
+        # watch sets: every contact node (teeth only in the engagement zones)
+        def zone(bm, nodes):
+            th = np.arctan2(bm.mesh.p[1, nodes], bm.mesh.p[0, nodes])
+            dth = np.abs(np.angle(np.exp(2j * th))) / 2   # distance to nearest major axis
+            return nodes[dth < math.radians(zone_deg)]
+        fs_w = np.concatenate([bms["fs"].node_sets["fs_bore"],
+                               zone(bms["fs"], bms["fs"].node_sets["fs_teeth"])])
+        cs_w = zone(bms["cs"], bms["cs"].node_sets["cs_teeth"])
+        ir_w = np.concatenate([bms["ir"].node_sets["ir_bore"], bms["ir"].node_sets["ir_race"]])
+        or_w = np.concatenate([bms["or"].node_sets["or_race"], bms["or"].node_sets["or_outer"]])
+        self.factorize_s = 0.0
+        self.bodies: dict[str, _Body] = {}
+        for name, w, fixed in (("fs", fs_w, None),
+                               ("cs", cs_w, bms["cs"].node_sets["cs_outer"]),
+                               ("ir", ir_w, None), ("or", or_w, None)):
+            b, tf = _make_body(name, bms[name], self.E, geom.nu, fixed, w)
+            self.factorize_s += tf
+            self.bodies[name] = b
+        ofs = 0
+        for b in self.bodies.values():
+            b.wofs = ofs
+            b.wpos = -np.ones((2, b.x.shape[1]), dtype=np.int64)
+            n = b.watch_nodes.size
+            b.wpos[0, b.watch_nodes] = ofs + 2 * np.arange(n)
+            b.wpos[1, b.watch_nodes] = ofs + 2 * np.arange(n) + 1
+            ofs += 2 * n
+        self.nwatch = ofs
+        self.n_dofs = sum(b.K.shape[0] for b in self.bodies.values())
+        # torque load pattern on the FS rim (below the tooth roots) and its twist measure
+        fs = self.bodies["fs"]
+        p = fs.x
+        rim_tri = np.hypot(*p[:, fs.bm.mesh.t].mean(axis=1)) < geom.r_fs_root
+        sub = fs.bm.mesh.t[:, rim_tri]
+        a = 0.5 * np.abs((p[0, sub[1]] - p[0, sub[0]]) * (p[1, sub[2]] - p[1, sub[0]])
+                         - (p[0, sub[2]] - p[0, sub[0]]) * (p[1, sub[1]] - p[1, sub[0]]))
+        w = np.zeros(p.shape[1])
+        for k in range(3):
+            np.add.at(w, sub[k], a / 3)
+        J = float(np.sum(w * (p[0] ** 2 + p[1] ** 2)))
+        q = np.zeros(fs.K.shape[0])
+        q[fs.nd[0]], q[fs.nd[1]] = -w * p[1] / J, w * p[0] / J
+        self.q = q                       # load per unit torque (N/(N mm)) and twist measure
+        self.uq = self._solve_body(fs, q[:, None])[:, 0]
+        self.uq_watch = self._watch_vec("fs", self.uq)
+        self.qq = float(q @ self.uq)
+        # rigid modes: (body, mode) -> column of R (watch restriction), twist, load
+        self.mode_list: list[tuple[str, str]] = []
+        self.ball_c = ball_compliance_coeff(geom, self.E)
+        # working set storage
+        self.rows: dict[str, _Rows] = {}
+        self._Xbuf = np.zeros((self.nwatch, 0))  # compliance columns on the watch dofs
+        self.Xq = np.zeros(0)                  # q^T K^-1 G^T
+        self._GW = None                        # rows of the working set
+        self.CW = np.zeros((0, 0))             # their compliance matrix
+        self.W: list[tuple[str, int]] = []     # working-set pairs (kind, row index)
+        self.Wpos: dict[tuple[str, int], int] = {}
+
+    # ---------------------------------------------------------------- linear algebra
+    def _solve_body(self, b: _Body, F: np.ndarray) -> np.ndarray:
+        U = np.zeros((b.K.shape[0], F.shape[1]))
+        U[b.free] = b.lu.solve(np.ascontiguousarray(F[b.free]))
+        return U
+
+    def _watch_vec(self, name: str, u_full: np.ndarray) -> np.ndarray:
+        b = self.bodies[name]
+        v = np.zeros(self.nwatch)
+        wn = b.watch_nodes
+        v[b.wpos[0, wn]] = u_full[b.nd[0, wn]]
+        v[b.wpos[1, wn]] = u_full[b.nd[1, wn]]
+        return v
+
+    def _watch_to_body(self, name: str, Gt: sp.csc_matrix) -> np.ndarray:
+        """Map watch-vector force columns (nwatch x k) to full-body force vectors."""
+        b = self.bodies[name]
+        wn = b.watch_nodes
+        F = np.zeros((b.K.shape[0], Gt.shape[1]))
+        Gd = Gt.toarray()
+        F[b.nd[0, wn]] = Gd[b.wpos[0, wn]]
+        F[b.nd[1, wn]] = Gd[b.wpos[1, wn]]
+        return F
+
+    def _columns(self, Grows: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
+        """K^-1 G^T for rows G (k x nwatch): watch restriction and q-projection."""
+        k = Grows.shape[0]
+        X = np.zeros((self.nwatch, k))
+        Xq = np.zeros(k)
+        Gt = Grows.T.tocsr()
+        for name, b in self.bodies.items():
+            sl = slice(b.wofs, b.wofs + 2 * b.watch_nodes.size)
+            cols = np.flatnonzero(np.diff(Gt[sl].tocsc().indptr))
+            if cols.size == 0:
+                continue
+            for c0 in range(0, cols.size, 256):   # bounded memory per batch
+                cc = cols[c0:c0 + 256]
+                Fw = Gt[:, cc].tocsc()
+                F = self._watch_to_body(name, Fw)
+                U = self._solve_body(b, F)
+                wn = b.watch_nodes
+                X[b.wpos[0, wn][:, None], cc[None, :]] += U[b.nd[0, wn]]
+                X[b.wpos[1, wn][:, None], cc[None, :]] += U[b.nd[1, wn]]
+                if name == "fs":
+                    Xq[cc] += self.q @ U
+        return X, Xq
+
+    # ---------------------------------------------------------------- rigid modes
+    def _R(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Watch restriction, twist and torque-load component of the active modes."""
+        R = np.zeros((self.nwatch, len(self.mode_list)))
+        Rq = np.zeros(len(self.mode_list))
+        Rf = np.zeros(len(self.mode_list))
+        for j, (bn, mn) in enumerate(self.mode_list):
+            v = self.bodies[bn].modes[mn]
+            R[:, j] = self._watch_vec(bn, v)
+            if bn == "fs":
+                Rq[j] = self.q @ v
+                Rf[j] = self.q @ v     # R^T f per unit torque
+        return R, Rq, Rf
+
+    # ---------------------------------------------------------------- rows
+    def cam_rows(self, u_watch: np.ndarray) -> _Rows:
+        ir = self.bodies["ir"]
+        nodes = ir.bm.node_sets["ir_bore"]
+        X = ir.x[:, nodes]
+        u = np.vstack([u_watch[ir.wpos[0, nodes]], u_watch[ir.wpos[1, nodes]]])
+        x = X + u
+        cp = cam_points(self.g.cam_A, self.g.cam_B, self.g.cam_n, 32768)
+        tree = cKDTree(cp)
+        _, j = tree.query(x.T)
+        best_g = np.full(x.shape[1], np.inf)
+        best_n = np.zeros((2, x.shape[1]))
+        nc = cp.shape[0]
+        for j0, j1 in ((j - 1, j), (j, j + 1)):
+            a, b = cp[j0 % nc].T, cp[j1 % nc].T
+            d = b - a
+            L2 = (d ** 2).sum(0)
+            t = np.clip(((x - a) * d).sum(0) / L2, 0, 1)
+            proj = a + t * d
+            n = np.vstack([d[1], -d[0]]) / np.sqrt(L2)       # outward for a CCW curve
+            gap = ((x - proj) * n).sum(0)
+            dist = np.hypot(*(x - proj))
+            better = dist < np.abs(best_g)
+            best_g = np.where(better, gap, best_g)
+            best_n = np.where(better, n, best_n)
+        k = nodes.size
+        r = np.repeat(np.arange(k), 2)
+        c = np.column_stack([ir.wpos[0, nodes], ir.wpos[1, nodes]]).ravel()
+        v = best_n.T.ravel()
+        G = sp.csr_matrix((v, (r, c)), shape=(k, self.nwatch))
+        g0 = best_g - G @ u_watch
+        return _Rows("cam", G, g0)
+
+    def ball_rows(self) -> _Rows:
+        g = self.g
+        ir, orr = self.bodies["ir"], self.bodies["or"]
+        thb = 2 * math.pi * np.arange(g.n_balls) / g.n_balls
+        def patches(b, nodes):
+            th = np.arctan2(b.x[1, nodes], b.x[0, nodes])
+            h = 2 * math.pi / nodes.size
+            out = []
+            for t in thb:
+                d = np.abs(np.angle(np.exp(1j * (th - t))))
+                out.append(nodes[d <= 1.01 * h])
+            return out
+        Gi = _radial_rows(ir, patches(ir, ir.bm.node_sets["ir_race"]), -1.0, self.nwatch)
+        Go = _radial_rows(orr, patches(orr, orr.bm.node_sets["or_race"]), +1.0, self.nwatch)
+        return _Rows("ball", (Gi + Go).tocsr(), np.full(g.n_balls, g.ball_gap))
+
+    def fit_rows(self) -> _Rows:
+        g = self.g
+        fs, orr = self.bodies["fs"], self.bodies["or"]
+        def bins(b, nodes):
+            th = np.mod(np.arctan2(b.x[1, nodes], b.x[0, nodes]), 2 * math.pi)
+            k = np.floor(th / (2 * math.pi) * self.n_bins + 0.5).astype(int) % self.n_bins
+            return [nodes[k == i] for i in range(self.n_bins)]
+        bf, bo = bins(fs, fs.bm.node_sets["fs_bore"]), bins(orr, orr.bm.node_sets["or_outer"])
+        if any(len(x) == 0 for x in bf + bo):
+            raise ValueError("mortar bins without nodes: mesh too coarse for n_bins")
+        G = (_radial_rows(fs, bf, +1.0, self.nwatch)
+             + _radial_rows(orr, bo, -1.0, self.nwatch)).tocsr()
+        return _Rows("fit", G, np.full(self.n_bins, g.r_fs_bore - g.or_outer))
+
+    def tooth_rows(self, u_watch: np.ndarray, cand_gap: float,
+                   nodes: np.ndarray | None = None) -> _Rows:
+        """FS tooth-boundary nodes against CS tooth-boundary segments, at the deformed
+        configuration, kept if the gap there is below ``cand_gap``; with ``nodes`` the
+        same slave nodes are re-paired and re-linearised (same rows, new geometry)."""
+        fs, cs = self.bodies["fs"], self.bodies["cs"]
+        sn = (np.intersect1d(fs.bm.node_sets["fs_teeth"], fs.watch_nodes) if nodes is None
+              else np.asarray(nodes))
+        xs = fs.x[:, sn] + np.vstack([u_watch[fs.wpos[0, sn]], u_watch[fs.wpos[1, sn]]])
+        E = cs.bm.edge_sets["cs_teeth"]
+        inz = (cs.wpos[0, E[:, 0]] >= 0) & (cs.wpos[0, E[:, 1]] >= 0)
+        E = E[inz]
+        nrm = _boundary_edge_normals(cs.bm.mesh, E)
+        ucs = lambda nodes: np.vstack([u_watch[cs.wpos[0, nodes]], u_watch[cs.wpos[1, nodes]]])
+        xa = cs.x[:, E[:, 0]] + ucs(E[:, 0])
+        xb = cs.x[:, E[:, 1]] + ucs(E[:, 1])
+        mid = 0.5 * (xa + xb)
+        tree = cKDTree(mid.T)
+        kq = min(8, E.shape[0])
+        _, cand = tree.query(xs.T, k=kq)
+        best = np.full(sn.size, np.inf)
+        bg = np.zeros(sn.size)
+        be = np.zeros(sn.size, dtype=np.int64)
+        bt = np.zeros(sn.size)
+        for jj in range(kq):
+            e = cand[:, jj]
+            a, b = xa[:, e], xb[:, e]
+            d = b - a
+            t = np.clip(((xs - a) * d).sum(0) / (d ** 2).sum(0), 0, 1)
+            pr = a + t * d
+            dist = np.hypot(*(xs - pr))
+            gap = ((xs - pr) * nrm[:, e]).sum(0)
+            better = dist < best
+            best = np.where(better, dist, best)
+            bg, be, bt = (np.where(better, gap, bg), np.where(better, e, be),
+                          np.where(better, t, bt))
+        keep = bg < cand_gap
+        sn, bg, be, bt = sn[keep], bg[keep], be[keep], bt[keep]
+        n = nrm[:, be]
+        k = sn.size
+        rows, cols, vals = [], [], []
+        for comp in (0, 1):
+            rows += [np.arange(k)] * 3
+            cols += [fs.wpos[comp, sn], cs.wpos[comp, E[be, 0]], cs.wpos[comp, E[be, 1]]]
+            vals += [n[comp], -(1 - bt) * n[comp], -bt * n[comp]]
+        G = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                          shape=(k, self.nwatch))
+        g0 = bg - G @ u_watch
+        th = np.arctan2(fs.x[1, sn], fs.x[0, sn])
+        tooth = np.round(th / (2 * math.pi / self.g.z_fs)).astype(int) % self.g.z_fs
+        return _Rows("tooth", G, g0, {"tooth": tooth, "nodes": sn})
+
+    # ---------------------------------------------------------------- working set
+    def _all_rows(self):
+        kinds = list(self.rows)
+        G = sp.vstack([self.rows[k].G for k in kinds]).tocsr()
+        g0 = np.concatenate([self.rows[k].g0 for k in kinds])
+        ids = [(k, i) for k in kinds for i in range(self.rows[k].G.shape[0])]
+        return G, g0, ids
+
+    def _add_to_W(self, ids: list[tuple[str, int]]):
+        ids = [i for i in ids if i not in self.Wpos]
+        if not ids:
+            return
+        Gn = sp.vstack([self.rows[k].G[i] for k, i in ids]).tocsr()
+        X, Xq = self._columns(Gn)
+        n0, k = len(self.W), len(ids)
+        if n0 + k > self._Xbuf.shape[1]:        # grow the column store geometrically
+            cap = max(2 * self._Xbuf.shape[1], n0 + k, 256)
+            buf = np.zeros((self.nwatch, cap))
+            buf[:, :n0] = self._Xbuf[:, :n0]
+            self._Xbuf = buf
+        self._Xbuf[:, n0:n0 + k] = X
+        for i in ids:
+            self.Wpos[i] = len(self.W)
+            self.W.append(i)
+        self.Xq = np.concatenate([self.Xq, Xq])
+        # compliance among the working set, C_ij = G_i K^-1 G_j^T, grown by new columns
+        self._GW = Gn if self._GW is None else sp.vstack([self._GW, Gn]).tocsr()
+        newcols = np.asarray(self._GW @ X)
+        CW = np.zeros((n0 + k, n0 + k))
+        CW[:n0, :n0] = self.CW
+        CW[:, n0:] = newcols
+        CW[n0:, :n0] = newcols[:n0].T
+        self.CW = CW
+
+    @property
+    def Xw(self) -> np.ndarray:
+        return self._Xbuf[:, :len(self.W)]
+
+    def _replace_rows(self, kind: str, rows: _Rows):
+        """New linearisation of one kind of rows (same count): refresh its columns."""
+        self.rows[kind] = rows
+        idx = [(self.Wpos[(k, i)], i) for (k, i) in self.W if k == kind]
+        if idx:
+            pos = np.array([a for a, _ in idx])
+            X, Xq = self._columns(rows.G[[b for _, b in idx]])
+            self._Xbuf[:, pos] = X
+            self.Xq[pos] = Xq
+            self._GW = sp.vstack([self.rows[k].G[i] for k, i in self.W]).tocsr()
+            self.CW = np.asarray(self._GW @ self.Xw)
+
+    # ---------------------------------------------------------------- one load level
+    def solve_level(self, T: float, active: dict | None):
+        """Solve the contact problem at torque T (N mm), warm-started from ``active``
+        (and the last displacement); Hertz secants of the balls iterated to 0.1 %."""
+        G, g0, ids = self._all_rows()
+        R, Rq, Rf = self._R()
+        GR = G @ R
+        ball_idx = np.array([j for j, (k, _) in enumerate(ids) if k == "ball"])
+        idpos = {i: j for j, i in enumerate(ids)}
+        act = set() if active is None else set(k for k, v in active.items() if v)
+        # initial: every violated pair at zero contact force
+        base = getattr(self, "_u_last", None)
+        u0 = T * self.uq_watch if base is None else base
+        gfree = g0 + G @ u0
+        act |= {ids[j] for j in np.flatnonzero(gfree < -self.tol_gap)}
+        pb = getattr(self, "_ball_p", None)
+        if pb is None:
+            pb = np.full(self.g.n_balls, 1.0)
+        for hertz_it in range(40):
+            s_ball = self.ball_c * np.maximum(pb, 1e-3) ** (-1.0 / 3.0)
+            p_full, alpha, u, gap, conv = self._pdas(T, G, g0, ids, idpos, R, Rq, Rf, GR,
+                                                     act, s_ball, ball_idx)
+            act = {ids[j] for j in np.flatnonzero(p_full > 0)}
+            pb_new = p_full[ball_idx]
+            on = pb_new > 0        # the secant of an open ball does not matter
+            change = (np.max(np.abs(pb_new - pb)[on]) if on.any() else 0.0) / max(
+                1e-9, np.max(np.abs(pb_new)))
+            pb = np.where(pb_new > 0, pb_new, pb)
+            if not conv:
+                raise ContactFailure(f"active-set iteration did not converge in "
+                                     f"{self.max_iter} iterations at T={T / 1000:.4g} N m")
+            if change < 1e-3:
+                break
+        else:
+            raise ContactFailure("Hertz secant iteration on ball loads did not converge")
+        self._ball_p = pb
+        self._u_last = u
+        wp = np.array([self.Wpos[i] for i in ids if i in self.Wpos], dtype=np.int64)
+        pw = np.array([p_full[idpos[i]] for i in ids if i in self.Wpos])
+        twist = T * self.qq + (self.Xq[wp] @ pw if wp.size else 0.0) + Rq @ alpha
+        return dict(p=p_full, alpha=alpha, u=u, gap=gap, ids=ids, twist=float(twist),
+                    active={i: True for i in act})
+
+    def _pdas(self, T, G, g0, ids, idpos, R, Rq, Rf, GR, act, s_ball, ball_idx):
+        """Primal-dual active set on the dense dual problem; see the module docstring."""
+        nm = R.shape[1]
+        npairs = len(ids)
+        sdiag = np.zeros(npairs)
+        sdiag[ball_idx] = s_ball
+        Guq = G @ self.uq_watch
+        A = set(act)
+        for it in range(self.max_iter):
+            self.iterations += 1
+            self._add_to_W(sorted(A - set(self.Wpos)))
+            # a loaded rigid mode with nothing holding it: add the first pair it closes
+            Al = sorted(A, key=lambda i: self.Wpos[i])
+            rows = [idpos[i] for i in Al]
+            for j in range(nm):
+                load = T * Rf[j]
+                if abs(load) < 1e-12:
+                    continue
+                held = np.abs(GR[rows, j]).max() if rows else 0.0
+                if held > 1e-12:
+                    continue
+                base = getattr(self, "_u_last", None)
+                gfree = g0 + G @ (base if base is not None else T * self.uq_watch)
+                rate = GR[:, j] * np.sign(load)
+                closing = np.flatnonzero(rate < -1e-12)
+                if closing.size == 0:
+                    raise ContactFailure(f"rigid mode {self.mode_list[j]} is loaded but no "
+                                         "contact pair can hold it")
+                need = gfree[closing] / (-rate[closing])
+                jbest = closing[np.argmin(need)]
+                A.add(ids[jbest])
+                self._add_to_W([ids[jbest]])
+            Al = sorted(A, key=lambda i: self.Wpos[i])
+            wp = np.array([self.Wpos[i] for i in Al], dtype=np.int64)
+            rows = np.array([idpos[i] for i in Al], dtype=np.int64)
+            nA = len(Al)
+            C = self.CW[np.ix_(wp, wp)]
+            C = 0.5 * (C + C.T) + np.diag(sdiag[rows])
+            H = GR[rows]
+            scale = np.abs(np.diag(C)).max() if nA else 1.0
+            M = np.zeros((nA + nm, nA + nm))
+            M[:nA, :nA] = C + 1e-13 * scale * np.eye(nA)
+            M[:nA, nA:] = H
+            M[nA:, :nA] = H.T
+            M[nA:, nA:] = -1e-14 * np.eye(nm)     # keeps unheld, unloaded modes at zero
+            rhs = np.concatenate([-(g0[rows] + T * Guq[rows]), -T * Rf])
+            try:
+                sol = np.linalg.solve(M, rhs)
+            except np.linalg.LinAlgError:
+                sol = np.linalg.lstsq(M, rhs, rcond=None)[0]
+            pA, alpha = sol[:nA], sol[nA:]
+            pW = np.zeros(len(self.W))
+            pW[wp] = pA
+            u = T * self.uq_watch + self.Xw @ pW + R @ alpha
+            p_full = np.zeros(npairs)
+            p_full[rows] = pA
+            gap = g0 + G @ u + sdiag * p_full
+            neg = [Al[k] for k in np.flatnonzero(pA < 0)]
+            viol = np.flatnonzero(gap < -self.tol_gap)
+            viol = viol[np.argsort(gap[viol])]
+            viol = [ids[j] for j in viol if ids[j] not in A]
+            # limited addition: the most violated few first (full switching cycles when
+            # a near-mechanism makes one iterate overshoot)
+            viol = viol[:max(self.add_min, int(self.add_frac * len(viol)))]
+            if self.debug:
+                kinds = [k for k, _ in Al]
+                print(f"it {it} nA {nA} teeth {kinds.count('tooth')} neg {len(neg)} viol {len(viol)} "
+                      f"ming {gap.min():.3g} alpha {np.round(alpha, 6)}")
+            if not neg and not viol:
+                p_full = np.maximum(p_full, 0.0)
+                return p_full, alpha, u, gap, True
+            if it > 25 and neg:          # anti-cycling: one change at a time
+                neg = [Al[int(np.argmin(pA))]]
+            A.difference_update(neg)
+            A.update(viol)
+        return p_full, alpha, u, gap, False
+
+
+# --------------------------------------------------------------------------------------
+# Public driver
+# --------------------------------------------------------------------------------------
+def _load_path(steps_per_ramp: int) -> np.ndarray:
+    n = steps_per_ramp
+    up = np.linspace(0, 1, n + 1)
+    return np.concatenate([up, up[::-1][1:], -up[1:], -up[::-1][1:]])
+
+
+def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int = 5,
+                      E: float | None = None, max_iter: int = 200,
+                      tol_gap: float = TOL_GAP) -> LostMotionResult:
+    """Simulate the lost-motion test 0 -> +T -> 0 -> -T -> 0 (WG locked, CS fixed).
+
+    ``E`` overrides Young's modulus (e.g. the rigid-body limit); ``max_iter`` limits the
+    active-set iterations per load level (a run that hits it returns status "failed").
+    """
+    t0 = time.perf_counter()
+    frac = _load_path(steps_per_ramp)
+    Tn = geom.torque
+    nan = float("nan")
+    empty = np.array([])
+    model = None
+    try:
+        model = LostMotionModel(geom, mesh, E=E, max_iter=max_iter, tol_gap=tol_gap)
+        # ---- stage 1: wave generator (no teeth), FS rotation pinned
+        model.mode_list = [("fs", "tx"), ("fs", "ty"), ("ir", "tx"), ("ir", "ty"),
+                           ("or", "tx"), ("or", "ty")]
+        model.rows["ball"] = model.ball_rows()
+        model.rows["fit"] = model.fit_rows()
+        u = np.zeros(model.nwatch)
+        model.rows["cam"] = model.cam_rows(u)
+        state = None
+        for geo_it in range(6):
+            state = model.solve_level(0.0, state["active"] if state else None)
+            u = state["u"]
+            new = model.cam_rows(u)
+            change = np.max(np.abs((new.g0 + new.G @ u) - (model.rows["cam"].g0
+                                                            + model.rows["cam"].G @ u)))
+            if change < 1e-6 and geo_it > 0:
+                break
+            model._replace_rows("cam", new)
+        u_wg = u
+        fs = model.bodies["fs"]
+        bore = fs.bm.node_sets["fs_bore"]
+        j0 = bore[np.argmin((fs.x[0, bore] - geom.r_fs_bore) ** 2 + fs.x[1, bore] ** 2)]
+        wg_defl = float(u_wg[fs.wpos[0, j0]]) * 1000.0
+        # ---- stage 2: teeth at the deflected configuration, FS rotation free
+        cand = 0.25 * geom.module + 3 * (geom.r_fs + geom.r_cs)
+        model.rows["tooth"] = model.tooth_rows(u_wg, cand)
+        model.mode_list = model.mode_list + [("fs", "rot")]
+        active = state["active"]
+        twists, maxpen, maxpen_nl, tooth_count = [], 0.0, 0.0, 0
+        last_sign = 1.0
+        for k, fr in enumerate(frac):
+            if abs(fr) > 1e-12:
+                last_sign = math.copysign(1.0, fr)
+                T = fr * Tn
+            else:
+                T = ZERO_TORQUE_BIAS * Tn * last_sign
+            st = model.solve_level(T, active)
+            if abs(abs(fr) - 1.0) < 1e-12:
+                # independent check at +-T: re-detect every FS/CS pair in the zones at the
+                # deformed configuration (nonlinear gap, no candidate threshold).  Large
+                # twists slide the flanks along each other; if the linearised pairing
+                # then misses more than RELIN_TOL, re-pair and re-linearise the tooth
+                # rows about this state and solve the level again.
+                for relin in range(4):
+                    chk = model.tooth_rows(st["u"], np.inf)
+                    pen_nl = float(-(chk.g0 + chk.G @ st["u"]).min())
+                    if pen_nl <= RELIN_TOL or relin == 3:
+                        break
+                    tr = model.rows["tooth"]
+                    new = model.tooth_rows(st["u"], np.inf, nodes=tr.info["nodes"])
+                    # only pairs at or near contact are re-linearised; the open flanks
+                    # keep the WG-state pairing, which is the right one for the way back
+                    near = (tr.g0 + tr.G @ st["u"]) < RELIN_NEAR
+                    Dn = sp.diags(near.astype(float))
+                    Df = sp.diags((~near).astype(float))
+                    mixed = _Rows("tooth", (Dn @ new.G + Df @ tr.G).tocsr(),
+                                  np.where(near, new.g0, tr.g0), tr.info)
+                    model._replace_rows("tooth", mixed)
+                    st = model.solve_level(T, st["active"])
+                maxpen_nl = max(maxpen_nl, pen_nl)
+            active = st["active"]
+            twists.append(st["twist"])
+            kinds = np.array([i[0] for i in st["ids"]])
+            geo_mask = kinds != "ball"
+            maxpen = max(maxpen, float(-(st["gap"][geo_mask]).min()))
+            if abs(fr - 1.0) < 1e-12:
+                tr = model.rows["tooth"]
+                ti = [i for (kk, i) in st["ids"] if kk == "tooth"]
+                pt = st["p"][kinds == "tooth"]
+                tooth_count = int(np.unique(tr.info["tooth"][np.array(ti)[pt > 0]]).size)
+        tw = np.array(twists) / ARCMIN
+        tw = tw - tw[0]
+        kp = int(np.argmin(np.abs(frac - 1.0)))
+        km = int(np.argmin(np.abs(frac + 1.0)))
+        phi_p, phi_m = float(tw[kp]), float(-tw[km])
+        return LostMotionResult(
+            phi_plus_arcmin=phi_p, phi_minus_arcmin=phi_m,
+            lost_motion_arcmin=phi_p + phi_m, step=np.arange(frac.size),
+            torque_Nm=frac * Tn / 1000.0, twist_arcmin=tw, teeth_in_contact=tooth_count,
+            max_penetration_um=max(0.0, maxpen) * 1000.0, iterations=model.iterations,
+            status="ok", reason="", solve_s=time.perf_counter() - t0,
+            factorize_s=model.factorize_s, n_dofs=model.n_dofs, wg_deflection_um=wg_defl,
+            max_penetration_redetected_um=max(0.0, maxpen_nl) * 1000.0,
+            notes=(f"zero-torque steps at {ZERO_TORQUE_BIAS:g} T_test towards the last load; "
+                   f"tooth penetration re-detected at the deformed state at +-T: "
+                   f"{max(0.0, maxpen_nl) * 1000:.4f} um"))
+    except Exception as exc:   # any failure is reported, never a silent number
+        return LostMotionResult(
+            phi_plus_arcmin=nan, phi_minus_arcmin=nan, lost_motion_arcmin=nan,
+            step=empty, torque_Nm=empty, twist_arcmin=empty, teeth_in_contact=0,
+            max_penetration_um=nan, iterations=model.iterations if model else 0,
+            status="failed", reason=f"{type(exc).__name__}: {exc}",
+            solve_s=time.perf_counter() - t0,
+            factorize_s=model.factorize_s if model else nan,
+            n_dofs=model.n_dofs if model else 0)

@@ -1,0 +1,395 @@
+"""Geometry of the two harmonic drives of the seed paper (HD 42 and HD 120).
+
+Hand-written because the paper gives only a handful of numbers (Tables 1-3: tooth counts,
+test torque, bearing d/D/B/d1/D1, parameter bounds, tooth heights 0.337 mm and 1.0 mm);
+every other dimension a finite-element model needs is *assumed* here, in ONE table
+(``_UNIT_TABLE``) with its source or reason next to it.  Units: mm, N, MPa, rad.
+
+Contents
+--------
+* ``DriveGeometry``: a frozen dataclass holding everything the mesh and the solver need for
+  one design (unit constants + the five design variables d, D, G_r, r_FS, r_CS + the cam).
+* ``drive_geometry(unit, d_mm, D_mm, Gr_mm, rFS_mm, rCS_mm)``: builds it.
+* the wave-generator cam of the paper's Eq. 3, R = A + B cos(2 (pi/2)(phi/(pi/2))^n),
+  with A, B solved numerically so that (1) the cam perimeter equals pi*d_nominal (the
+  inner-ring bore is inextensible and wraps the cam) and (2) the nominal design pushes the
+  flexspline (FS) out by w0 = m at the major axis (2-tooth difference).
+* the tooth flanks: involutes (pressure angle alpha).  Why involute: it is the only profile
+  whose normal offset is again the same profile rotated by offset/r_b, so a normal offset
+  r_FS / r_CS maps to a *known* rigid-body backlash 2 (r_FS + r_CS) / r_b -- the analytic
+  reference the FE model is tested against.  Harmonic Drive's own S-profile is patented and
+  not given in the paper.  FS flanks are offset by r_FS normal to the flank into the tooth
+  (thinner teeth, smaller dimension over pins), CS flanks by r_CS into the CS material
+  (wider spaces, larger dimension between pins), as in the paper's Fig. 5.  Zero offsets
+  are the nominal zero-backlash design: with the nominal bearing the major-axis FS tooth
+  then sits in its CS space touching both flanks at the pitch point.
+* ``geometric_backlash_rad/arcmin``: the rigid-body backlash the offsets create.
+
+Levels versus the paper (read before comparing numbers): a normal flank offset r opens a
+clearance r on each flank, so the rigid-body backlash alone is 2 (r_FS + r_CS) / r_b,CS,
+e.g. 13.4 arcmin for the HD 42 upper bounds (20 + 20 um) and >= 5.9 arcmin for every
+HD 120 design (offsets >= 25 um each).  The paper's Phi (0.18-1.49 / 0.64-2.51 arcmin) is
+about ten times smaller than this kinematic bound, so its offsets cannot have opened
+clearance one-to-one; with the definition used here our Phi ranks the paper's designs
+well but its level is about ten times higher.  The cam is sized so that the *nominal*
+bearing (d_nom, D_nom, G_r,nom) gives w0 = m; bore clearance (d > d_nom), a loose FS fit
+(D < D_nom) and a larger G_r give less deflection, i.e. extra radial clearance that opens
+dr sin(alpha) on each flank.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+ARCMIN = math.pi / (180.0 * 60.0)  # rad per arcmin
+
+# --------------------------------------------------------------------------------------
+# The one table of values.  "paper" = seed paper; "bg" = /work/shared/background.md
+# (derived there from the paper); "assumed" = our choice, reason given.
+# --------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class UnitData:
+    """Constants of one drive (paper values and our assumptions, see ``_UNIT_TABLE``)."""
+    z_fs: int
+    z_cs: int
+    torque_Nmm: float
+    d_nom: float
+    D_nom: float
+    Gr_nom: float
+    d1: float
+    D1: float
+    B: float
+    module: float
+    tooth_height: float
+    addendum_frac: float
+    alpha_deg: float
+    face_fs: float
+    face_cs: float
+    cs_rim: float
+    n_balls: int
+    ball_dia: float
+    groove_conf: float
+    cam_n: float
+
+
+_UNIT_TABLE: dict[str, "UnitData"] = {
+    "hd42": UnitData(
+        z_fs=240, z_cs=242,                 # paper Table 1
+        torque_Nmm=960.0,                   # paper Table 1: 4 % of T_N = 24 N m -> 0.96 N m
+        d_nom=31.000, D_nom=42.000,         # paper Tables 2/3 (113-1145TN)
+        Gr_nom=0.015,                       # paper Table 3 nominal radial clearance
+        d1=33.10, D1=40.10, B=7.00,         # paper Table 2 (raceway shoulders, width)
+        module=0.18,                        # bg: FS bore = D, wall under roots ~2 m -> 0.18
+        tooth_height=0.337,                 # paper, Conclusions
+        addendum_frac=0.45,                 # assumed: addendum 0.45 h, dedendum 0.55 h leaves
+                                            # 0.1 h tip/root clearance at the major axis
+        alpha_deg=20.0,                     # assumed: standard involute pressure angle
+        face_fs=7.0, face_cs=7.0,           # assumed: tooth face width = bearing width B
+        cs_rim=3.0,                         # assumed: CS ring radial thickness below roots
+                                            # (~17 m, CSF-17 proportions); clamped outside
+        n_balls=24,                         # assumed: ~80 % of the 29 that fit on the pitch
+                                            # circle; even -> 180 deg point symmetry
+        ball_dia=3.969,                     # assumed: 5/32" ball fills the 3.5 mm shoulder
+                                            # gap (D1-d1)/2 plus two groove depths
+        groove_conf=0.52,                   # assumed: usual deep-groove conformity f = r/dw
+        cam_n=1.0,                          # assumed: Eq. 3 exponent; n = 1 -> cos 2 phi cam
+    ),
+    "hd120": UnitData(
+        z_fs=240, z_cs=242,                 # paper Table 1
+        torque_Nmm=21160.0,                 # paper Table 1: 4 % of 529 N m
+        d_nom=90.000, D_nom=120.000,        # paper Tables 2/3 (114-876TN)
+        Gr_nom=0.030,                       # paper Table 3 nominal
+        d1=95.20, D1=114.80, B=18.00,       # paper Table 2
+        module=0.514,                       # bg: pitch dia ~123.3 mm
+        tooth_height=1.0,                   # paper, Conclusions
+        addendum_frac=0.45,                 # assumed, as HD 42
+        alpha_deg=20.0,                     # assumed, as HD 42
+        face_fs=18.0, face_cs=18.0,         # assumed: = bearing width B
+        cs_rim=8.6,                         # assumed: HD 42 value scaled by module ratio
+        n_balls=24,                         # assumed, as HD 42
+        ball_dia=11.112,                    # assumed: 7/16" ball for the 9.8 mm shoulder gap
+        groove_conf=0.52,                   # assumed
+        cam_n=1.0,                          # assumed
+    ),
+}
+
+# Where each value of the table comes from: printed in the report's assumptions table.
+_SOURCES: dict[str, tuple[str, str]] = {   # field -> (unit of the value, source or reason)
+    "z_fs": ("–", "paper Table 1"),
+    "z_cs": ("–", "paper Table 1"),
+    "torque_Nmm": ("N·mm", "paper Table 1: 4 % of the rated torque T_N"),
+    "d_nom": ("mm", "paper Tables 2/3: nominal bearing bore"),
+    "D_nom": ("mm", "paper Tables 2/3: nominal bearing outside diameter; the FS bore is made to it"),
+    "Gr_nom": ("mm", "paper Table 3: nominal radial clearance; the cam is sized with it"),
+    "d1": ("mm", "paper Table 2: inner-ring raceway shoulder"),
+    "D1": ("mm", "paper Table 2: outer-ring raceway shoulder"),
+    "B": ("mm", "paper Table 2: bearing width"),
+    "module": ("mm", "background: FS bore = D and wall under the roots about 2 m"),
+    "tooth_height": ("mm", "paper, Conclusions"),
+    "addendum_frac": ("–", "assumed: addendum 0.45 h, dedendum 0.55 h leave 0.1 h tip/root clearance"),
+    "alpha_deg": ("°", "assumed: involute pressure angle 20° (standard)"),
+    "face_fs": ("mm", "assumed: FS tooth face width = bearing width B"),
+    "face_cs": ("mm", "assumed: CS tooth face width = bearing width B"),
+    "cs_rim": ("mm", "assumed: CS rim under the roots (CSF-17 proportions, scaled by module for HD 120)"),
+    "n_balls": ("–", "assumed: about 80 % of the balls that fit; even for 180° symmetry"),
+    "ball_dia": ("mm", "assumed: inch ball filling the shoulder gap (D1 − d1)/2 plus two groove depths"),
+    "groove_conf": ("–", "assumed: usual deep-groove conformity f = r/d_w"),
+    "cam_n": ("–", "assumed: Eq. 3 exponent n = 1 (a cos 2φ cam)"),
+}
+
+
+def assumptions_table() -> list[dict]:
+    """Every constant of both drives with its unit and source, for the report."""
+    rows = []
+    for unit, data in _UNIT_TABLE.items():
+        for name, (quantity_unit, source) in _SOURCES.items():
+            value = getattr(data, name)
+            rows.append({"unit": {"hd42": "HD 42", "hd120": "HD 120"}[unit], "name": name,
+                         "value": f"{value:g} {quantity_unit}".replace(" –", ""), "source": source})
+    rows.append({"unit": "both", "name": "E, ν", "value": f"{E_STEEL:g} MPa, {NU_STEEL:g}", "source": "paper Sect. 4"})
+    return rows
+
+
+E_STEEL = 210_000.0  # MPa, paper Sec. 4
+NU_STEEL = 0.3       # paper Sec. 4
+
+
+@dataclass(frozen=True)
+class DriveGeometry:
+    unit: str
+    # design variables (paper Table 3)
+    d: float
+    D: float
+    Gr: float
+    r_fs: float
+    r_cs: float
+    # unit constants
+    z_fs: int
+    z_cs: int
+    module: float
+    alpha: float            # pressure angle, rad
+    torque: float           # test torque, N mm
+    E: float
+    nu: float
+    face_fs: float
+    face_cs: float
+    # bearing
+    d_nom: float
+    D_nom: float
+    Gr_nom: float
+    d1: float
+    D1: float
+    B: float
+    n_balls: int
+    ball_dia: float
+    groove_conf: float
+    # FS (external teeth); FS bore is made to the nominal bearing OD
+    r_fs_bore: float
+    r_fs_root: float
+    r_fs_pitch: float
+    r_fs_tip: float
+    # CS (internal teeth)
+    r_cs_tip: float
+    r_cs_pitch: float
+    r_cs_root: float
+    r_cs_outer: float
+    # cam of Eq. 3
+    cam_A: float
+    cam_B: float
+    cam_n: float
+
+    # ---- derived quantities -------------------------------------------------------
+    @property
+    def w0(self) -> float:
+        """Design radial deflection of the FS at the major axis (2-tooth difference)."""
+        return self.module * (self.z_cs - self.z_fs) / 2.0
+
+    @property
+    def r_fs_base(self) -> float:
+        return self.r_fs_pitch * math.cos(self.alpha)
+
+    @property
+    def r_cs_base(self) -> float:
+        return self.r_cs_pitch * math.cos(self.alpha)
+
+    @property
+    def ir_bore(self) -> float:
+        """Inner ring bore radius (design variable d)."""
+        return self.d / 2.0
+
+    @property
+    def ir_race(self) -> float:
+        return self.d1 / 2.0
+
+    @property
+    def or_race(self) -> float:
+        return self.D1 / 2.0
+
+    @property
+    def or_outer(self) -> float:
+        """Outer ring outer radius (design variable D)."""
+        return self.D / 2.0
+
+    @property
+    def ball_gap(self) -> float:
+        """Radial gap per ball: half the radial internal clearance G_r."""
+        return self.Gr / 2.0
+
+    @property
+    def arcmin_per_um(self) -> float:
+        """Rotation of the FS pitch circle per micrometre of arc, arcmin."""
+        return 1e-3 / self.r_fs_pitch / ARCMIN
+
+    def cam_radius(self, phi):
+        return cam_radius(phi, self.cam_A, self.cam_B, self.cam_n)
+
+
+def unit_data(unit: str) -> UnitData:
+    """The frozen constants of "hd42" or "hd120"."""
+    try:
+        return _UNIT_TABLE[unit.lower()]
+    except KeyError:
+        raise ValueError(f"unknown unit {unit!r}; expected one of {sorted(_UNIT_TABLE)}")
+
+
+# --------------------------------------------------------------------------------------
+# Cam, Eq. 3 of the paper
+# --------------------------------------------------------------------------------------
+def _fold(phi):
+    """Map any angle to [0, pi/2] with the cam's two mirror symmetries."""
+    p = np.mod(np.asarray(phi, dtype=float), np.pi)
+    return np.where(p > np.pi / 2, np.pi - p, p)
+
+
+def cam_radius(phi, A: float, B: float, n: float):
+    """R(phi) = A + B cos(2 (pi/2) (phi/(pi/2))^n), mirrored to the full circle."""
+    p = _fold(phi)
+    return A + B * np.cos(np.pi * (p / (np.pi / 2)) ** n)
+
+
+def cam_perimeter(A: float, B: float, n: float, npts: int = 20000) -> float:
+    """Perimeter of the closed cam curve (dense polyline, chord error ~1e-9 mm)."""
+    phi = np.linspace(0.0, np.pi / 2, npts + 1)
+    r = cam_radius(phi, A, B, n)
+    x, y = r * np.cos(phi), r * np.sin(phi)
+    return 4.0 * float(np.sum(np.hypot(np.diff(x), np.diff(y))))
+
+
+def cam_points(A: float, B: float, n: float, npts: int = 4096) -> np.ndarray:
+    """Closed polyline (npts x 2) of the cam, counter-clockwise from the major axis."""
+    phi = np.linspace(0.0, 2 * np.pi, npts, endpoint=False)
+    r = cam_radius(phi, A, B, n)
+    return np.column_stack([r * np.cos(phi), r * np.sin(phi)])
+
+
+def size_cam(d_nom: float, major_radius: float, n: float) -> tuple[float, float]:
+    """Solve A, B: perimeter = pi d_nom and A + B = major_radius (cam radius at phi = 0)."""
+    def res(B):
+        return cam_perimeter(major_radius - B, B, n) - math.pi * d_nom
+    B = brentq(res, 0.0, 0.2 * major_radius, xtol=1e-12)
+    return major_radius - B, B
+
+
+# --------------------------------------------------------------------------------------
+# Involute flanks
+# --------------------------------------------------------------------------------------
+def inv(a):
+    return np.tan(a) - a
+
+
+def fs_half_angle(g: DriveGeometry, r):
+    """Half tooth-thickness angle of an FS tooth at radius r (tooth centred on angle 0).
+
+    Nominal arc thickness at the pitch circle is pi m / 2; the normal offset r_FS on each
+    flank rotates that involute by r_FS / r_b towards the tooth centre.
+    """
+    r = np.asarray(r, dtype=float)
+    rb = g.r_fs_base
+    ar = np.arccos(np.clip(rb / r, -1, 1))
+    return (math.pi * g.module / 2) / (2 * g.r_fs_pitch) + inv(g.alpha) - inv(ar) - g.r_fs / rb
+
+
+def cs_half_space_angle(g: DriveGeometry, r):
+    """Half space-width angle of a CS tooth space at radius r (space centred on angle 0).
+
+    The space of an internal gear is the mirror of an external tooth cut by the same rack,
+    so it has the same involute form; r_CS widens it by r_CS / r_b per flank.
+    """
+    r = np.asarray(r, dtype=float)
+    rb = g.r_cs_base
+    ar = np.arccos(np.clip(rb / r, -1, 1))
+    return (math.pi * g.module / 2) / (2 * g.r_cs_pitch) + inv(g.alpha) - inv(ar) + g.r_cs / rb
+
+
+# --------------------------------------------------------------------------------------
+# Rigid-body backlash (analytic reference)
+# --------------------------------------------------------------------------------------
+def geometric_backlash_rad(g: DriveGeometry, radial_shortfall_mm: float = 0.0) -> float:
+    """Rigid-body lost motion of the major-axis tooth pair, rad.
+
+    At the major axis the FS pitch point coincides with the CS pitch point P (radius
+    r_pCS).  Both flanks are involutes through P with pressure angle alpha there, so the
+    normal clearance on each flank is r_FS + r_CS (+ radial_shortfall * sin(alpha) if the
+    FS does not reach the full deflection w0), and a rigid FS rotation psi about the drive
+    centre closes it at the rate |x_P x n| = r_pCS cos(alpha) = r_b,CS.  The FS can turn
+    both ways, so Phi = 2 (r_FS + r_CS + dr sin alpha) / r_b,CS.
+    """
+    gap = g.r_fs + g.r_cs + radial_shortfall_mm * math.sin(g.alpha)
+    return 2.0 * gap / g.r_cs_base
+
+
+def geometric_backlash_arcmin(g: DriveGeometry, radial_shortfall_mm: float = 0.0) -> float:
+    return geometric_backlash_rad(g, radial_shortfall_mm) / ARCMIN
+
+
+# --------------------------------------------------------------------------------------
+# Builder
+# --------------------------------------------------------------------------------------
+def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: float,
+                   rCS_mm: float) -> DriveGeometry:
+    """Geometry of one design of unit "hd42" or "hd120" (all lengths in mm)."""
+    from dataclasses import asdict
+    t = asdict(unit_data(unit))
+    m = t["module"]
+    h = t["tooth_height"]
+    ha = t["addendum_frac"] * h
+    hf = h - ha
+    r_fs_pitch = t["z_fs"] * m / 2
+    r_cs_pitch = t["z_cs"] * m / 2
+    w0 = m * (t["z_cs"] - t["z_fs"]) / 2
+    # Cam: the nominal bearing (bore d_nom wrapped on the cam, radial clearance Gr_nom, OD
+    # = FS bore) must push the FS out by w0 at the major axis, rigid-body: A + B equals the
+    # bore radius + w0 + Gr_nom/2 (the ball gap on the loaded side).
+    A, B = size_cam(t["d_nom"], t["d_nom"] / 2 + w0 + t["Gr_nom"] / 2, t["cam_n"])
+    return DriveGeometry(
+        unit=unit.lower(), d=float(d_mm), D=float(D_mm), Gr=float(Gr_mm),
+        r_fs=float(rFS_mm), r_cs=float(rCS_mm),
+        z_fs=int(t["z_fs"]), z_cs=int(t["z_cs"]), module=m,
+        alpha=math.radians(t["alpha_deg"]), torque=t["torque_Nmm"], E=E_STEEL, nu=NU_STEEL,
+        face_fs=t["face_fs"], face_cs=t["face_cs"],
+        d_nom=t["d_nom"], D_nom=t["D_nom"], Gr_nom=t["Gr_nom"], d1=t["d1"], D1=t["D1"],
+        B=t["B"], n_balls=int(t["n_balls"]), ball_dia=t["ball_dia"],
+        groove_conf=t["groove_conf"],
+        r_fs_bore=t["D_nom"] / 2, r_fs_root=r_fs_pitch - hf, r_fs_pitch=r_fs_pitch,
+        r_fs_tip=r_fs_pitch + ha,
+        r_cs_tip=r_cs_pitch - ha, r_cs_pitch=r_cs_pitch, r_cs_root=r_cs_pitch + hf,
+        r_cs_outer=r_cs_pitch + hf + t["cs_rim"],
+        cam_A=A, cam_B=B, cam_n=t["cam_n"],
+    )
+
+
+def nominal_geometry(unit: str) -> DriveGeometry:
+    """Table 3 nominal design (zero offsets for HD 42, 0.025 mm for HD 120)."""
+    if unit.lower() == "hd42":
+        return drive_geometry("hd42", 31.0, 42.0, 0.015, 0.0, 0.0)
+    return drive_geometry("hd120", 90.0, 120.0, 0.030, 0.025, 0.025)
+
+
+def with_changes(g: DriveGeometry, **kw) -> DriveGeometry:
+    """Copy with some fields replaced (e.g. a stiffer E for the rigid-body limit)."""
+    from dataclasses import replace
+    return replace(g, **kw)

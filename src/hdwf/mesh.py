@@ -1,0 +1,285 @@
+"""Plane (2D section) meshes of one harmonic-drive design, built with the gmsh Python API.
+
+Four separate bodies, meshed with linear triangles and returned as scikit-fem ``MeshTri``:
+
+* ``fs``  flexspline ring: bore (made to the nominal bearing OD) + all 240 external teeth;
+* ``cs``  circular-spline ring: all 242 internal teeth + outer rim (the support);
+* ``ir``  bearing inner ring: bore d (sits on the cam) to raceway d1;
+* ``or``  bearing outer ring: raceway D1 to outer diameter D (sits in the FS bore).
+
+The balls are NOT meshed: each is a discrete unilateral Hertz element between the two
+raceways (see ``hdwf.fe``); the cam is a rigid analytic curve (``hdwf.geometry``), not
+meshed either.  Only the contact surfaces need to be named; physical groups:
+``fs_bore``, ``fs_teeth`` (flanks, tips and roots), ``cs_teeth``, ``cs_outer`` (support),
+``ir_bore``, ``ir_race``, ``or_race``, ``or_outer`` and one surface group per body.
+
+Density follows the paper (Sec. 4): each tooth flank is split into ``elements_over_height``
+segments and the tooth thickness at the pitch circle into ``elements_over_thickness``;
+the rim grades to about twice that size at the FS bore and to a coarse size at the CS
+outer rim.  ``refinement`` multiplies every element count (divides every size).
+Hand-written parts: only the tooth outlines (involute points from ``hdwf.geometry``) and
+the conversion of gmsh's arrays into per-body scikit-fem meshes.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import gmsh
+import numpy as np
+from skfem import MeshTri
+
+from .geometry import DriveGeometry, cs_half_space_angle, fs_half_angle
+
+MESH_ALGORITHM = 6   # gmsh 2D: 6 = Frontal-Delaunay (quality); 5 = Delaunay
+
+
+@dataclass
+class BodyMesh:
+    name: str
+    mesh: MeshTri
+    thickness: float                       # plane-stress thickness (face width), mm
+    node_sets: dict[str, np.ndarray] = field(default_factory=dict)   # group -> node ids
+    edge_sets: dict[str, np.ndarray] = field(default_factory=dict)   # group -> (k, 2) ids
+
+
+@dataclass
+class DriveMesh:
+    bodies: dict[str, BodyMesh]
+    sizes: dict[str, float]
+
+    @property
+    def n_nodes(self) -> int:
+        return sum(b.mesh.p.shape[1] for b in self.bodies.values())
+
+
+def _sizes(g: DriveGeometry, n_h: int, n_t: int, refinement: float) -> dict[str, float]:
+    h_tooth = g.r_fs_tip - g.r_fs_root
+    s_pitch = math.pi * g.module / 2
+    nh = max(2, int(round(n_h * refinement)))
+    nt = max(2, int(round(n_t * refinement)))
+    s = min(h_tooth / nh, s_pitch / nt)
+    return dict(
+        n_flank=nh,
+        tooth=s,
+        fs_bore=2.0 * s,
+        cs_outer=max(4.0 * s, (g.r_cs_outer - g.r_cs_root) / max(3.0, 4 * refinement)),
+        ring=min((g.d1 - g.d) / 2, (g.D - g.D1) / 2) / max(3.0, 6.0 * refinement),
+    )
+
+
+def _circle(geo, r: float, size: float, c: int, nseg: int | None = None) -> list[int]:
+    """Full circle as 4 arcs (geo arcs must span < pi), optional transfinite count."""
+    pts = [geo.addPoint(r * math.cos(a), r * math.sin(a), 0.0, size)
+           for a in np.arange(4) * math.pi / 2]
+    arcs = [geo.addCircleArc(pts[i], c, pts[(i + 1) % 4]) for i in range(4)]
+    return arcs
+
+
+def _flank_radii(r0: float, r1: float, n: int) -> np.ndarray:
+    return np.linspace(r0, r1, n)
+
+
+def _fs_outline(geo, g: DriveGeometry, c: int, s: dict) -> tuple[list[int], list[int]]:
+    """Closed toothed outline of the FS (counter-clockwise). Returns (curves, flanks)."""
+    z = g.z_fs
+    rr = _flank_radii(g.r_fs_root, g.r_fs_tip, 12)
+    psi = fs_half_angle(g, rr)
+    curves, flanks = [], []
+    first_pt = prev_pt = None
+    for i in range(z):
+        th = 2 * math.pi * i / z
+        # rising flank (clockwise side of the tooth), root -> tip
+        a = th - psi
+        pa = [geo.addPoint(r * math.cos(t), r * math.sin(t), 0.0, s["tooth"])
+              for r, t in zip(rr, a)]
+        if prev_pt is not None:     # root land from previous tooth
+            curves.append(geo.addCircleArc(prev_pt, c, pa[0]))
+        else:
+            first_pt = pa[0]
+        fa = geo.addSpline(pa)
+        b = th + psi
+        pb = [geo.addPoint(r * math.cos(t), r * math.sin(t), 0.0, s["tooth"])
+              for r, t in zip(rr[::-1], b[::-1])]
+        tip = geo.addCircleArc(pa[-1], c, pb[0])
+        fb = geo.addSpline(pb)
+        curves += [fa, tip, fb]
+        flanks += [fa, fb]
+        prev_pt = pb[-1]
+    curves.append(geo.addCircleArc(prev_pt, c, first_pt))
+    return curves, flanks
+
+
+def _cs_outline(geo, g: DriveGeometry, c: int, s: dict) -> tuple[list[int], list[int]]:
+    """Closed toothed inner outline of the CS (counter-clockwise); spaces centred on
+    2 pi j / z_cs so that FS tooth 0 (angle 0) enters CS space 0 at the major axis."""
+    z = g.z_cs
+    rr = _flank_radii(g.r_cs_tip, g.r_cs_root, 12)
+    eta = cs_half_space_angle(g, rr)
+    curves, flanks = [], []
+    first_pt = prev_pt = None
+    for j in range(z):
+        th = 2 * math.pi * j / z
+        a = th - eta                           # space flank on the clockwise side, tip -> root
+        pa = [geo.addPoint(r * math.cos(t), r * math.sin(t), 0.0, s["tooth"])
+              for r, t in zip(rr, a)]
+        if prev_pt is not None:                # CS tooth tip land
+            curves.append(geo.addCircleArc(prev_pt, c, pa[0]))
+        else:
+            first_pt = pa[0]
+        fa = geo.addSpline(pa)
+        b = th + eta
+        pb = [geo.addPoint(r * math.cos(t), r * math.sin(t), 0.0, s["tooth"])
+              for r, t in zip(rr[::-1], b[::-1])]
+        root = geo.addCircleArc(pa[-1], c, pb[0])
+        fb = geo.addSpline(pb)
+        curves += [fa, root, fb]
+        flanks += [fa, fb]
+        prev_pt = pb[-1]
+    curves.append(geo.addCircleArc(prev_pt, c, first_pt))
+    return curves, flanks
+
+
+def build_mesh(geom: DriveGeometry, elements_over_height: int = 10,
+               elements_over_thickness: int = 6, refinement: float = 1.0,
+               path: str | None = None) -> DriveMesh:
+    """Mesh the four bodies; write ``path`` (.msh) if given; return per-body meshes."""
+    g = geom
+    s = _sizes(g, elements_over_height, elements_over_thickness, refinement)
+    gmsh.initialize(interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.option.setNumber("General.NumThreads", 1)
+        gmsh.model.add("hd")
+        geo = gmsh.model.geo
+        c = geo.addPoint(0, 0, 0, 1.0)
+
+        groups: dict[str, tuple[int, list[int]]] = {}
+        # --- FS
+        fs_out, fs_fl = _fs_outline(geo, g, c, s)
+        fs_bore = _circle(geo, g.r_fs_bore, s["fs_bore"], c)
+        fs_surf = geo.addPlaneSurface([geo.addCurveLoop(fs_out), geo.addCurveLoop(fs_bore)])
+        groups["fs"] = (2, [fs_surf])
+        groups["fs_teeth"] = (1, fs_out)
+        groups["fs_bore"] = (1, fs_bore)
+        # --- CS
+        cs_in, cs_fl = _cs_outline(geo, g, c, s)
+        cs_outer = _circle(geo, g.r_cs_outer, s["cs_outer"], c)
+        cs_surf = geo.addPlaneSurface([geo.addCurveLoop(cs_outer), geo.addCurveLoop(cs_in)])
+        groups["cs"] = (2, [cs_surf])
+        groups["cs_teeth"] = (1, cs_in)
+        groups["cs_outer"] = (1, cs_outer)
+        # --- bearing rings
+        ir_bore = _circle(geo, g.ir_bore, s["ring"], c)
+        ir_race = _circle(geo, g.ir_race, s["ring"], c)
+        ir_surf = geo.addPlaneSurface([geo.addCurveLoop(ir_race), geo.addCurveLoop(ir_bore)])
+        or_race = _circle(geo, g.or_race, s["ring"], c)
+        or_outer = _circle(geo, g.or_outer, s["ring"], c)
+        or_surf = geo.addPlaneSurface([geo.addCurveLoop(or_outer), geo.addCurveLoop(or_race)])
+        groups.update({"ir": (2, [ir_surf]), "ir_bore": (1, ir_bore), "ir_race": (1, ir_race),
+                       "or": (2, [or_surf]), "or_race": (1, or_race),
+                       "or_outer": (1, or_outer)})
+        geo.synchronize()
+
+        # transfinite flanks: exactly n_flank segments over the tooth height
+        for cv in fs_fl + cs_fl:
+            gmsh.model.mesh.setTransfiniteCurve(cv, s["n_flank"] + 1)
+        # uniform node spacing on the circular contact surfaces (mortar bins need no
+        # matching, but uniform spacing keeps the bin weights even)
+        def _tf(arcs, r, h):
+            n = max(2, int(math.ceil(0.5 * math.pi * r / h)))
+            for a in arcs:
+                gmsh.model.mesh.setTransfiniteCurve(a, n + 1)
+        _tf(fs_bore, g.r_fs_bore, s["fs_bore"])
+        for arcs, r in ((ir_bore, g.ir_bore), (ir_race, g.ir_race), (or_race, g.or_race),
+                        (or_outer, g.or_outer)):
+            _tf(arcs, r, s["ring"])
+        _tf(cs_outer, g.r_cs_outer, s["cs_outer"])
+
+        for name, (dim, tags) in groups.items():
+            gmsh.model.addPhysicalGroup(dim, tags, name=name)
+        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 1)
+        gmsh.option.setNumber("Mesh.Algorithm", MESH_ALGORITHM)
+        gmsh.model.mesh.generate(2)
+        if path is not None:
+            gmsh.write(str(path))
+
+        ntags, coords, _ = gmsh.model.mesh.getNodes()
+        xy = np.zeros((int(ntags.max()) + 1, 2))
+        xy[ntags.astype(np.int64)] = coords.reshape(-1, 3)[:, :2]
+
+        def _body(name, surf, thick, bnames):
+            et, _, enodes = gmsh.model.mesh.getElements(2, surf)
+            tri = np.asarray(enodes[list(et).index(2)], dtype=np.int64).reshape(-1, 3)
+            used = np.unique(tri)
+            loc = -np.ones(xy.shape[0], dtype=np.int64)
+            loc[used] = np.arange(used.size)
+            p = xy[used].T.copy()
+            t = loc[tri].T.copy()
+            # counter-clockwise orientation
+            a = ((p[0, t[1]] - p[0, t[0]]) * (p[1, t[2]] - p[1, t[0]])
+                 - (p[0, t[2]] - p[0, t[0]]) * (p[1, t[1]] - p[1, t[0]]))
+            sw = a < 0
+            t[1, sw], t[2, sw] = t[2, sw].copy(), t[1, sw].copy()
+            bm = BodyMesh(name, MeshTri(p, t), thick)
+            for bn in bnames:
+                edges = []
+                for cv in groups[bn][1]:
+                    et1, _, en1 = gmsh.model.mesh.getElements(1, cv)
+                    edges.append(np.asarray(en1[list(et1).index(1)],
+                                            dtype=np.int64).reshape(-1, 2))
+                e = loc[np.vstack(edges)]
+                bm.edge_sets[bn] = e
+                bm.node_sets[bn] = np.unique(e)
+            return bm
+
+        bodies = {
+            "fs": _body("fs", fs_surf, g.face_fs, ["fs_teeth", "fs_bore"]),
+            "cs": _body("cs", cs_surf, g.face_cs, ["cs_teeth", "cs_outer"]),
+            "ir": _body("ir", ir_surf, g.B, ["ir_bore", "ir_race"]),
+            "or": _body("or", or_surf, g.B, ["or_race", "or_outer"]),
+        }
+    finally:
+        gmsh.finalize()
+    return DriveMesh(bodies, s)
+
+
+def annulus_mesh(r_in: float, r_out: float, size: float) -> BodyMesh:
+    """Plain ring (for verification tests): groups ``inner`` and ``outer``."""
+    gmsh.initialize(interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("annulus")
+        geo = gmsh.model.geo
+        c = geo.addPoint(0, 0, 0, size)
+        inner = _circle(geo, r_in, size, c)
+        outer = _circle(geo, r_out, size, c)
+        surf = geo.addPlaneSurface([geo.addCurveLoop(outer), geo.addCurveLoop(inner)])
+        geo.synchronize()
+        gmsh.model.addPhysicalGroup(2, [surf], name="ring")
+        gmsh.model.mesh.generate(2)
+        ntags, coords, _ = gmsh.model.mesh.getNodes()
+        xy = np.zeros((int(ntags.max()) + 1, 2))
+        xy[ntags.astype(np.int64)] = coords.reshape(-1, 3)[:, :2]
+        et, _, en = gmsh.model.mesh.getElements(2, surf)
+        tri = np.asarray(en[list(et).index(2)], dtype=np.int64).reshape(-1, 3)
+        used = np.unique(tri)
+        loc = -np.ones(xy.shape[0], dtype=np.int64)
+        loc[used] = np.arange(used.size)
+        p, t = xy[used].T.copy(), loc[tri].T.copy()
+        a = ((p[0, t[1]] - p[0, t[0]]) * (p[1, t[2]] - p[1, t[0]])
+             - (p[0, t[2]] - p[0, t[0]]) * (p[1, t[1]] - p[1, t[0]]))
+        sw = a < 0
+        t[1, sw], t[2, sw] = t[2, sw].copy(), t[1, sw].copy()
+        bm = BodyMesh("ring", MeshTri(p, t), 1.0)
+        for name, arcs in (("inner", inner), ("outer", outer)):
+            edges = []
+            for cv in arcs:
+                et1, _, en1 = gmsh.model.mesh.getElements(1, cv)
+                edges.append(np.asarray(en1[list(et1).index(1)], dtype=np.int64).reshape(-1, 2))
+            e = loc[np.vstack(edges)]
+            bm.edge_sets[name], bm.node_sets[name] = e, np.unique(e)
+    finally:
+        gmsh.finalize()
+    return bm
