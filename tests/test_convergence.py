@@ -36,3 +36,25 @@ def test_oscillation_is_flagged():
 def test_sizes_must_be_ordered():
     with pytest.raises(ValueError):
         gci((1.0, 0.5, 2.0), (1, 1, 1))
+
+
+def test_convergence_table_two_and_three_meshes():
+    import pandas as pd
+
+    from hdwf.fe_study import convergence_table
+
+    exact, c = 5.0, 0.8
+    rows = []
+    for did, refs in (("a", (1.0, 0.75, 0.5)), ("b", (1.0, 0.75))):
+        for r in refs:
+            h = 0.034 / r
+            rows.append({"design_id": did, "refinement": r, "h_mm": h, "lost_motion_arcmin": exact + c * h ** 2})
+    rows.append({"design_id": "c", "refinement": 1.0, "h_mm": 0.034, "lost_motion_arcmin": float("nan")})
+    rows.append({"design_id": "c", "refinement": 0.75, "h_mm": 0.045, "lost_motion_arcmin": 5.0})
+    table = convergence_table(pd.DataFrame(rows)).set_index("design_id")
+    f1, f2 = exact + c * 0.034 ** 2, exact + c * (0.034 / 0.75) ** 2
+    assert table.loc["a", "rel_change_fine"] == pytest.approx(abs(f2 - f1) / f1)
+    assert table.loc["a", "order_p"] == pytest.approx(2.0, rel=1e-6)
+    assert table.loc["a", "phi_extrapolated_arcmin"] == pytest.approx(exact, rel=1e-9)
+    assert bool(table.loc["b", "converged"]) and math.isnan(table.loc["b", "gci_fine"])
+    assert not bool(table.loc["c", "converged"]) and "failed" in table.loc["c", "note"]

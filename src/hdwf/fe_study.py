@@ -177,22 +177,25 @@ def convergence_table(results: pd.DataFrame) -> pd.DataFrame:
     lost_motion_arcmin.
     """
     out = []
+    levels = ("fine", "medium", "coarse")
     for design_id, sub in results.groupby("design_id", sort=True):
         sub = sub.sort_values("h_mm")  # fine first
-        if len(sub) != 3 or sub["lost_motion_arcmin"].isna().any():
-            out.append({"design_id": design_id, "converged": False, "note": "a refinement failed"})
-            continue
-        h = tuple(sub["h_mm"]) 
-        phi = tuple(sub["lost_motion_arcmin"])
-        g = gci(h, phi)
-        levels = ("fine", "medium", "coarse")
-        out.append({"design_id": design_id,
-                    **{f"refinement_{k}": float(v) for k, v in zip(levels, sub["refinement"])},
-                    **{f"h_{k}_mm": float(v) for k, v in zip(levels, h)},
-                    **{f"phi_{k}_arcmin": float(v) for k, v in zip(levels, phi)},
-                    "rel_change_fine": g.rel_change_fine, "gci_fine": g.gci_fine, "order_p": g.p,
-                    "phi_extrapolated_arcmin": g.phi_extrapolated, "monotone": g.monotone,
-                    "converged": bool(g.rel_change_fine < 0.02), "note": ""})
+        row = {"design_id": design_id}
+        for k, r in zip(levels, sub.itertuples()):
+            row.update({f"refinement_{k}": float(r.refinement), f"h_{k}_mm": float(r.h_mm),
+                        f"phi_{k}_arcmin": float(r.lost_motion_arcmin)})
+        phi = sub["lost_motion_arcmin"].to_numpy(float)
+        if len(sub) < 2 or not np.isfinite(phi).all():
+            row.update({"converged": False, "note": "a refinement failed or is missing"})
+        else:
+            row["rel_change_fine"] = float(abs(phi[1] - phi[0]) / abs(phi[0]))
+            row["converged"] = bool(row["rel_change_fine"] < 0.02)
+            row["note"] = ""
+            if len(sub) == 3:
+                g = gci(tuple(sub["h_mm"]), tuple(phi))
+                row.update({"gci_fine": g.gci_fine, "order_p": g.p, "phi_extrapolated_arcmin": g.phi_extrapolated,
+                            "monotone": g.monotone})
+        out.append(row)
     return pd.DataFrame(out)
 
 

@@ -203,6 +203,7 @@ def build_mesh(geom: DriveGeometry, elements_over_height: int = 10,
         gmsh.option.setNumber("Mesh.Algorithm", MESH_ALGORITHM)
         gmsh.model.mesh.generate(2)
         if path is not None:
+            gmsh.option.setNumber("Mesh.Binary", 1)  # 4x smaller and faster to write; gmsh reads it back
             gmsh.write(str(path))
 
         ntags, coords, _ = gmsh.model.mesh.getNodes()

@@ -102,11 +102,13 @@ rule fe_refined_solve:
 
 
 def _convergence_inputs(w):
-    finest = FE["refinement"]
+    """Every design on the second-finest mesh; every k-th also on the coarsest (for the GCI)."""
+    finest, second, coarsest = sorted(FE["convergence"]["refinements"], reverse=True)
+    designs = design_ids(w.study, w.unit)
+    every = FE["convergence"]["representative_every"]
     files = {"default": f"results/{w.study}/{w.unit}/lost_motion.parquet"}
-    files["coarser"] = [f"results/{w.study}/{w.unit}/convergence/r{r:g}/{d}.parquet"
-                        for r in FE["convergence"]["refinements"] if r != finest
-                        for d in design_ids(w.study, w.unit)]
+    files["coarser"] = [f"results/{w.study}/{w.unit}/convergence/r{second:g}/{d}.parquet" for d in designs]
+    files["coarser"] += [f"results/{w.study}/{w.unit}/convergence/r{coarsest:g}/{d}.parquet" for d in designs[::every]]
     return files
 
 
