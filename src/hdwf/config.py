@@ -58,9 +58,10 @@ def _check_relations(config: dict, source) -> None:
         if fe["refinement"] != max(refs):
             raise ConfigError(source, "the default mesh must be the finest of the three (the study runs on it)",
                               field="fe.refinement", value=fe["refinement"])
-        study = fe["convergence"]["study"]
-        if study not in config["studies"] or config["studies"][study]["source"] != "fe":
-            raise ConfigError(source, "must name an fe study", field="fe.convergence.study", value=study)
+        for key in ("convergence", "picture"):
+            study = fe.get(key, {}).get("study")
+            if study is not None and (study not in config["studies"] or config["studies"][study]["source"] != "fe"):
+                raise ConfigError(source, "must name an fe study", field=f"fe.{key}.study", value=study)
     for name, study in config.get("studies", {}).items():
         if study["source"] == "paper" and study.get("designs", "paper") != "paper":
             raise ConfigError(source, "a paper study uses the paper's designs", field=f"studies.{name}.designs",

@@ -323,6 +323,7 @@ class LostMotionResult:
     wg_deflection_um: float = float("nan")   # FS bore radial displacement at major axis
     max_penetration_redetected_um: float = float("nan")  # tooth pairs re-found at +-T
     notes: str = ""
+    fields: dict | None = None   # with keep_fields: {"wg": {...}, "plus": {...}} body -> (2, n) mm
 
     @property
     def curve(self) -> dict[str, np.ndarray]:
@@ -634,6 +635,24 @@ class LostMotionModel:
             self._GW = sp.vstack([self.rows[k].G[i] for k, i in self.W]).tocsr()
             self.CW = np.asarray(self._GW @ self.Xw)
 
+    # ---------------------------------------------------------------- full fields
+    def full_displacements(self, st: dict, T: float) -> dict[str, np.ndarray]:
+        """Displacement (2, nnodes) of every body at a solved level, u = K^-1 (f + G^T p) + R alpha
+        (the same superposition the twist is read from); one back-substitution per body."""
+        G, _, _ = self._all_rows()
+        force_watch = sp.csc_matrix((G.T @ st["p"])[:, None])
+        out = {}
+        for name, b in self.bodies.items():
+            F = self._watch_to_body(name, force_watch)
+            if name == "fs":
+                F[:, 0] += T * self.q
+            u = self._solve_body(b, F)[:, 0]
+            for j, (bn, mn) in enumerate(self.mode_list):
+                if bn == name:
+                    u = u + st["alpha"][j] * b.modes[mn]
+            out[name] = np.vstack([u[b.nd[0]], u[b.nd[1]]])
+        return out
+
     # ---------------------------------------------------------------- one load level
     def solve_level(self, T: float, active: dict | None):
         """Solve the contact problem at torque T (N mm), warm-started from ``active``
@@ -766,11 +785,13 @@ def _load_path(steps_per_ramp: int) -> np.ndarray:
 
 def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int = 5,
                       E: float | None = None, max_iter: int = 200,
-                      tol_gap: float = TOL_GAP) -> LostMotionResult:
+                      tol_gap: float = TOL_GAP, keep_fields: bool = False) -> LostMotionResult:
     """Simulate the lost-motion test 0 -> +T -> 0 -> -T -> 0 (WG locked, CS fixed).
 
     ``E`` overrides Young's modulus (e.g. the rigid-body limit); ``max_iter`` limits the
-    active-set iterations per load level (a run that hits it returns status "failed").
+    active-set iterations per load level (a run that hits it returns status "failed");
+    ``keep_fields`` also returns the displacement of every node after the wave generator
+    is mounted (``wg``) and at +T (``plus``).
     """
     t0 = time.perf_counter()
     frac = _load_path(steps_per_ramp)
@@ -798,6 +819,7 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
                 break
             model._replace_rows("cam", new)
         u_wg = u
+        fields = {"wg": model.full_displacements(state, 0.0)} if keep_fields else None
         fs = model.bodies["fs"]
         bore = fs.bm.node_sets["fs_bore"]
         j0 = bore[np.argmin((fs.x[0, bore] - geom.r_fs_bore) ** 2 + fs.x[1, bore] ** 2)]
@@ -845,6 +867,8 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
             geo_mask = kinds != "ball"
             maxpen = max(maxpen, float(-(st["gap"][geo_mask]).min()))
             if abs(fr - 1.0) < 1e-12:
+                if keep_fields and "plus" not in fields:
+                    fields["plus"] = model.full_displacements(st, T)
                 tr = model.rows["tooth"]
                 ti = [i for (kk, i) in st["ids"] if kk == "tooth"]
                 pt = st["p"][kinds == "tooth"]
@@ -864,7 +888,8 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
             max_penetration_redetected_um=max(0.0, maxpen_nl) * 1000.0,
             notes=(f"zero-torque steps at {ZERO_TORQUE_BIAS:g} T_test towards the last load; "
                    f"tooth penetration re-detected at the deformed state at +-T: "
-                   f"{max(0.0, maxpen_nl) * 1000:.4f} um"))
+                   f"{max(0.0, maxpen_nl) * 1000:.4f} um"),
+            fields=fields)
     except Exception as exc:   # any failure is reported, never a silent number
         return LostMotionResult(
             phi_plus_arcmin=nan, phi_minus_arcmin=nan, lost_motion_arcmin=nan,

@@ -216,3 +216,28 @@ def write_convergence(results: pd.DataFrame, out, provenance: dict, meta: dict) 
 
 def write_run_summary(path, **facts) -> Path:
     return write_json(facts, path)
+
+
+def deformed_stage(designs_path, design_id: str, unit: str, settings: dict, steps_per_ramp: int, out_png,
+                   out_npz, provenance: dict) -> dict:
+    """Solve one design keeping the displacement fields; picture of the mesh near the major axis."""
+    from .fe import solve_lost_motion
+    from .mesh import build_mesh
+    from .plots import deformed_figure
+
+    params = design_parameters(designs_path, design_id)
+    geom = geometry_of(unit, params)
+    mesh = build_mesh(geom, settings["elements_over_height"], settings["elements_over_thickness"],
+                      settings.get("refinement", 1.0))
+    res = solve_lost_motion(geom, mesh, steps_per_ramp=steps_per_ramp, keep_fields=True)
+    if res.status != "ok":
+        raise RuntimeError(f"{design_id}: solve failed ({res.reason}); no picture of a failed state")
+    arrays = {f"{state}:{body}": u for state, per_body in res.fields.items() for body, u in per_body.items()}
+    with atomic_path(out_npz) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez_compressed(fh, **arrays)
+    pitch = 2 * np.pi * geom.r_fs_pitch / geom.z_fs
+    deformed_figure(mesh, res.fields, f"{unit} {design_id} at +4 % T_N (Φ = {res.lost_motion_arcmin:.3f} arcmin), "
+                    "true scale", out_png, half_width_mm=2.5 * pitch,
+                    xlim=(geom.r_fs_bore - 2 * geom.module, geom.r_cs_root + 3 * geom.module))
+    return {"design_id": design_id, "lost_motion_arcmin": res.lost_motion_arcmin}

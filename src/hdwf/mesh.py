@@ -81,64 +81,46 @@ def _flank_radii(r0: float, r1: float, n: int) -> np.ndarray:
     return np.linspace(r0, r1, n)
 
 
-def _fs_outline(geo, g: DriveGeometry, c: int, s: dict) -> tuple[list[int], list[int]]:
-    """Closed toothed outline of the FS (counter-clockwise). Returns (curves, flanks)."""
-    z = g.z_fs
-    rr = _flank_radii(g.r_fs_root, g.r_fs_tip, 12)
-    psi = fs_half_angle(g, rr)
+def _toothed_outline(geo, z: int, rr: np.ndarray, half_angle: np.ndarray, c: int,
+                     size: float) -> tuple[list[int], list[int]]:
+    """Closed toothed outline (counter-clockwise) of z teeth or spaces centred on 2 pi i / z.
+
+    Each period: the clockwise flank at angles -half_angle(r) over the radii ``rr``, an arc
+    across (FS tooth tip or CS space root), the other flank back, then the land to the next
+    period. Returns (curves, flanks).
+    """
     curves, flanks = [], []
     first_pt = prev_pt = None
     for i in range(z):
         th = 2 * math.pi * i / z
-        # rising flank (clockwise side of the tooth), root -> tip
-        a = th - psi
-        pa = [geo.addPoint(r * math.cos(t), r * math.sin(t), 0.0, s["tooth"])
-              for r, t in zip(rr, a)]
-        if prev_pt is not None:     # root land from previous tooth
+        pa = [geo.addPoint(r * math.cos(t), r * math.sin(t), 0.0, size) for r, t in zip(rr, th - half_angle)]
+        if prev_pt is not None:     # land from the previous period
             curves.append(geo.addCircleArc(prev_pt, c, pa[0]))
         else:
             first_pt = pa[0]
         fa = geo.addSpline(pa)
-        b = th + psi
-        pb = [geo.addPoint(r * math.cos(t), r * math.sin(t), 0.0, s["tooth"])
-              for r, t in zip(rr[::-1], b[::-1])]
-        tip = geo.addCircleArc(pa[-1], c, pb[0])
+        pb = [geo.addPoint(r * math.cos(t), r * math.sin(t), 0.0, size)
+              for r, t in zip(rr[::-1], (th + half_angle)[::-1])]
+        across = geo.addCircleArc(pa[-1], c, pb[0])
         fb = geo.addSpline(pb)
-        curves += [fa, tip, fb]
+        curves += [fa, across, fb]
         flanks += [fa, fb]
         prev_pt = pb[-1]
     curves.append(geo.addCircleArc(prev_pt, c, first_pt))
     return curves, flanks
+
+
+def _fs_outline(geo, g: DriveGeometry, c: int, s: dict) -> tuple[list[int], list[int]]:
+    """Outer outline of the FS: teeth centred on 2 pi i / z_FS, flanks root -> tip."""
+    rr = _flank_radii(g.r_fs_root, g.r_fs_tip, 12)
+    return _toothed_outline(geo, g.z_fs, rr, fs_half_angle(g, rr), c, s["tooth"])
 
 
 def _cs_outline(geo, g: DriveGeometry, c: int, s: dict) -> tuple[list[int], list[int]]:
-    """Closed toothed inner outline of the CS (counter-clockwise); spaces centred on
-    2 pi j / z_cs so that FS tooth 0 (angle 0) enters CS space 0 at the major axis."""
-    z = g.z_cs
+    """Inner outline of the CS: spaces centred on 2 pi j / z_CS so that FS tooth 0 (angle 0)
+    enters CS space 0 at the major axis; flanks tip -> root."""
     rr = _flank_radii(g.r_cs_tip, g.r_cs_root, 12)
-    eta = cs_half_space_angle(g, rr)
-    curves, flanks = [], []
-    first_pt = prev_pt = None
-    for j in range(z):
-        th = 2 * math.pi * j / z
-        a = th - eta                           # space flank on the clockwise side, tip -> root
-        pa = [geo.addPoint(r * math.cos(t), r * math.sin(t), 0.0, s["tooth"])
-              for r, t in zip(rr, a)]
-        if prev_pt is not None:                # CS tooth tip land
-            curves.append(geo.addCircleArc(prev_pt, c, pa[0]))
-        else:
-            first_pt = pa[0]
-        fa = geo.addSpline(pa)
-        b = th + eta
-        pb = [geo.addPoint(r * math.cos(t), r * math.sin(t), 0.0, s["tooth"])
-              for r, t in zip(rr[::-1], b[::-1])]
-        root = geo.addCircleArc(pa[-1], c, pb[0])
-        fb = geo.addSpline(pb)
-        curves += [fa, root, fb]
-        flanks += [fa, fb]
-        prev_pt = pb[-1]
-    curves.append(geo.addCircleArc(prev_pt, c, first_pt))
-    return curves, flanks
+    return _toothed_outline(geo, g.z_cs, rr, cs_half_space_angle(g, rr), c, s["tooth"])
 
 
 def build_mesh(geom: DriveGeometry, elements_over_height: int = 10,

@@ -137,3 +137,48 @@ def agreement_figure(pairs: dict[str, tuple[np.ndarray, np.ndarray]], title: str
         ax.grid(alpha=0.3)
     fig.suptitle(title)
     _save(fig, path)
+
+
+def _without_rotation(p: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """u minus its least-squares rigid rotation about the drive axis (what deforms, not what turns)."""
+    theta = float(np.sum(p[0] * u[1] - p[1] * u[0]) / np.sum(p[0] ** 2 + p[1] ** 2))
+    return u - theta * np.vstack([-p[1], p[0]])
+
+
+def deformed_figure(mesh, fields: dict, title: str, path, half_width_mm: float, xlim: tuple[float, float],
+                    magnify: float = 1.0) -> None:
+    """FS and CS near the major axis (+x) in the deformed state at +T, true scale.
+
+    Colour: deformation added by the test torque (u at +T minus u after mounting the wave
+    generator, each body's rigid rotation removed), in µm — where the load goes. Bearing
+    rings are drawn grey.
+    """
+    from matplotlib.collections import PolyCollection
+
+    fig, ax = plt.subplots(figsize=(8, 5.5))
+    plus, wg = fields["plus"], fields["wg"]
+    values, polys = [], []
+    ymax = half_width_mm
+    for name, body in mesh.bodies.items():
+        p, t = body.mesh.p, body.mesh.t
+        x = p + magnify * plus[name]
+        centre = p[:, t].mean(axis=1)
+        keep = (centre[0] > xlim[0] - 0.5) & (centre[0] < xlim[1] + 0.5) & (np.abs(centre[1]) < ymax + 0.5)
+        tri = x[:, t[:, keep]].transpose(2, 1, 0)  # (n, 3, 2)
+        if name in ("fs", "cs"):
+            du = np.hypot(*_without_rotation(p, plus[name] - wg[name]))[t[:, keep]].mean(axis=0) * 1000.0
+            polys.append(tri)
+            values.append(du)
+        else:
+            ax.add_collection(PolyCollection(tri, facecolors="0.85", edgecolors="0.6", linewidths=0.1))
+    coll = PolyCollection(np.concatenate(polys), array=np.concatenate(values), cmap="viridis",
+                          edgecolors="k", linewidths=0.05)
+    ax.add_collection(coll)
+    fig.colorbar(coll, ax=ax, label="deformation from the test torque, rotation removed (µm)")
+    ax.set_xlim(*xlim)
+    ax.set_ylim(-ymax, ymax)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (mm), major axis")
+    ax.set_ylabel("y (mm)")
+    ax.set_title(title, fontsize=10)
+    _save(fig, path)

@@ -312,7 +312,8 @@ def _sub(files: dict[str, str], study: str) -> dict[str, str]:
     return {k[len(prefix):]: v for k, v in files.items() if k.startswith(prefix)}
 
 
-def _fe_model_section(doc: Document, assumptions: list[dict] | None, level: int = 1):
+def _fe_model_section(doc: Document, assumptions: list[dict] | None, pictures: dict[str, str] | None = None,
+                      level: int = 1):
     doc.heading("The FE model", level)
     doc.text("A 2D plane-stress section of each drive (gmsh mesh, scikit-fem assembly, linear-elastic steel, "
              "$E = 210$ GPa, $nu = 0.3$, thickness = face width) with unilateral frictionless contact between the "
@@ -324,6 +325,10 @@ def _fe_model_section(doc: Document, assumptions: list[dict] | None, level: int 
         rows = [[lit(a["unit"]), lit(a["name"]), lit(a["value"]), lit(a["source"])] for a in assumptions]
         doc.table(["drive", "quantity", "value", "source or reason"], rows,
                   "Every value the paper does not give, with its source (`hdwf.geometry`).")
+    for label, path in (pictures or {}).items():
+        doc.figure(path, f"{label}: the FS (left) and CS (right) teeth at the major axis at +4 % $T_N$, true scale; "
+                   "colour: deformation added by the test torque with each body's rotation removed. The white "
+                   "gaps are the clearance that $r_\"FS\"$ and $r_\"CS\"$ open.", width="75%")
 
 
 def _convergence_section(doc: Document, units, files, level: int = 1):
@@ -463,7 +468,8 @@ def full_report(files: dict[str, str], studies: dict[str, dict], data_dir, prove
             doc.pagebreak()
         if fe_studies:
             doc.heading("Part II — our FE model", 1)
-            _fe_model_section(doc, assumptions, 2)
+            pics = {UNIT_NAMES[k.split("__")[1]]: v for k, v in files.items() if k.endswith("__deformed_png")}
+            _fe_model_section(doc, assumptions, pics, 2)
             conv = [s for s in fe_studies if any(k.startswith(f"{s}__") and k.endswith("__convergence") for k in files)]
             for study in conv:
                 _convergence_section(doc, studies[study]["units"], _sub(files, study), 2)

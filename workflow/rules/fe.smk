@@ -126,3 +126,21 @@ rule fe_convergence:
         "results/logs/{study}_{unit}_convergence.log",
     script:
         "../scripts/fe_convergence.py"
+
+
+rule fe_deformed:
+    # One design solved again keeping every node's displacement, for the report's picture.
+    input:
+        "results/{study}/{unit}/designs.parquet",
+    output:
+        png="results/{study}/{unit}/deformed_{design}.png",
+        fields="results/{study}/{unit}/deformed_{design}.npz",
+    params:
+        settings={k: FE[k] for k in ("elements_over_height", "elements_over_thickness", "refinement")},
+        steps_per_ramp=FE["steps_per_ramp"],
+        repo=REPO_DIR,
+    threads: 1
+    log:
+        "results/logs/{study}_{unit}_deformed_{design}.log",
+    script:
+        "../scripts/fe_deformed.py"

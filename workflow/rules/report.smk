@@ -49,6 +49,8 @@ def full_report_inputs(wildcards):
                 files[f"{study}__{unit}__curves"] = f"results/{study}/{unit}/curves.parquet"
             if study == FE["convergence"]["study"]:
                 files[f"{study}__{unit}__convergence"] = f"results/{study}/{unit}/convergence.parquet"
+            if study == FE["picture"]["study"]:
+                files[f"{study}__{unit}__deformed_png"] = f"results/{study}/{unit}/deformed_{FE['picture']['design']}.png"
     return files
 
 
