@@ -39,6 +39,15 @@ def geometry_of(unit: str, params: dict[str, float]):
 
 # ------------------------------------------------------------------ mesh storage
 
+def _mesh(geom, settings: dict, path=None):
+    """Mesh with the study's settings; ``symmetry`` is passed only when it is not the full model."""
+    from .mesh import build_mesh
+
+    extra = {} if settings.get("symmetry", "full") == "full" else {"symmetry": settings["symmetry"]}
+    return build_mesh(geom, settings["elements_over_height"], settings["elements_over_thickness"],
+                      settings.get("refinement", 1.0), path=path, **extra)
+
+
 def save_drive_mesh(mesh, path) -> Path:
     arrays = {"__sizes__": np.array(json.dumps(mesh.sizes))}
     for name, body in mesh.bodies.items():
@@ -80,15 +89,12 @@ def load_drive_mesh(path):
 
 def mesh_stage(designs_path, design_id: str, unit: str, settings: dict, out_msh, out_npz) -> dict:
     """Mesh one design: gmsh ``.msh`` for review, ``.npz`` for the solver; returns mesh facts."""
-    from .mesh import build_mesh
-
     geom = geometry_of(unit, design_parameters(designs_path, design_id))
     t0 = time.perf_counter()
     with atomic_path(out_msh) as tmp_msh:
         # gmsh picks the format from the extension, so the temporary name keeps ".msh".
         tmp_named = tmp_msh.with_suffix(".msh")
-        mesh = build_mesh(geom, settings["elements_over_height"], settings["elements_over_thickness"],
-                          settings.get("refinement", 1.0), path=str(tmp_named))
+        mesh = _mesh(geom, settings, path=str(tmp_named))
         tmp_named.replace(tmp_msh)
     save_drive_mesh(mesh, out_npz)
     return {"design_id": design_id, "n_nodes": mesh.n_nodes, "mesh_s": time.perf_counter() - t0}
@@ -157,11 +163,8 @@ def designs_stage(source: str, unit: str, source_path, data_dir, out, provenance
 def refined_solve_stage(designs_path, design_id: str, unit: str, settings: dict, steps_per_ramp: int, out,
                         provenance: dict) -> dict:
     """Mesh and solve one design at another refinement (mesh-convergence runs); one row out."""
-    from .mesh import build_mesh
-
     params = design_parameters(designs_path, design_id)
-    mesh = build_mesh(geometry_of(unit, params), settings["elements_over_height"],
-                      settings["elements_over_thickness"], settings["refinement"])
+    mesh = _mesh(geometry_of(unit, params), settings)
     row, _ = solve_design(unit, params, mesh, steps_per_ramp, design_id)
     row["refinement"] = float(settings["refinement"])
     write_parquet(pd.DataFrame([row]), out, provenance=provenance, meta={"unit": unit})
@@ -222,13 +225,11 @@ def deformed_stage(designs_path, design_id: str, unit: str, settings: dict, step
                    out_npz, provenance: dict) -> dict:
     """Solve one design keeping the displacement fields; picture of the mesh near the major axis."""
     from .fe import solve_lost_motion
-    from .mesh import build_mesh
     from .plots import deformed_figure
 
     params = design_parameters(designs_path, design_id)
     geom = geometry_of(unit, params)
-    mesh = build_mesh(geom, settings["elements_over_height"], settings["elements_over_thickness"],
-                      settings.get("refinement", 1.0))
+    mesh = _mesh(geom, settings)
     res = solve_lost_motion(geom, mesh, steps_per_ramp=steps_per_ramp, keep_fields=True)
     if res.status != "ok":
         raise RuntimeError(f"{design_id}: solve failed ({res.reason}); no picture of a failed state")

@@ -31,7 +31,7 @@ rule fe_mesh:
         msh="results/{study}/{unit}/mesh/{design}.msh",
         npz="results/{study}/{unit}/mesh/{design}.npz",
     params:
-        settings={k: FE[k] for k in ("elements_over_height", "elements_over_thickness", "refinement")},
+        settings={k: FE[k] for k in ("elements_over_height", "elements_over_thickness", "refinement", "symmetry")},
         repo=REPO_DIR,
     threads: 1
     log:
@@ -89,7 +89,8 @@ rule fe_refined_solve:
         "results/{study}/{unit}/convergence/r{ref}/{design}.parquet",
     params:
         settings=lambda w: {"elements_over_height": FE["elements_over_height"],
-                            "elements_over_thickness": FE["elements_over_thickness"], "refinement": float(w.ref)},
+                            "elements_over_thickness": FE["elements_over_thickness"], "refinement": float(w.ref),
+                            "symmetry": FE["symmetry"]},
         steps_per_ramp=FE["steps_per_ramp"],
         repo=REPO_DIR,
     threads: 1
@@ -136,7 +137,7 @@ rule fe_deformed:
         png="results/{study}/{unit}/deformed_{design}.png",
         fields="results/{study}/{unit}/deformed_{design}.npz",
     params:
-        settings={k: FE[k] for k in ("elements_over_height", "elements_over_thickness", "refinement")},
+        settings={k: FE[k] for k in ("elements_over_height", "elements_over_thickness", "refinement", "symmetry")},
         steps_per_ramp=FE["steps_per_ramp"],
         repo=REPO_DIR,
     threads: 1

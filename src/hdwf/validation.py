@@ -1,0 +1,171 @@
+"""Model against measurements: comparison error, validation uncertainty, residual tests.
+
+ASME V&V 20 vocabulary: S the simulation, D the measured value, comparison error
+E = S − D, validation uncertainty u_val = √(u_num² + u_input² + u_D²); |E| well above
+2·u_val points to model-form error. Residual tests use statsmodels: a regression of the
+per-specimen error on the five inputs (does the error follow a design parameter?), Ramsey's
+RESET on measured-versus-predicted (is the relation non-linear?), and a regression of the
+error on torque and load branch (where along the curve does the model fail?).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import pandas as pd
+import statsmodels.api as sm
+from statsmodels.stats.diagnostic import linear_reset
+
+from . import PARAMETER_COLUMNS
+
+BRANCHES = ("load+", "unload+", "load-", "unload-")
+
+
+def branches(torque: np.ndarray) -> list[str]:
+    """Label each point of a 0 → +T → 0 → −T → 0 test by its branch.
+
+    A point belongs to the branch it was reached on: |T| rising gives ``load±``, falling
+    ``unload±``; the sign is that of the torque (zero-torque points take the branch they end).
+    """
+    t = np.asarray(torque, float)
+    out, prev, sign = [], 0.0, 1.0
+    for x in t:
+        if x != 0:
+            sign = np.sign(x)
+        rising = abs(x) > abs(prev) or (abs(x) == abs(prev) == 0 and not out)
+        out.append(("load" if rising else "unload") + ("+" if sign > 0 else "-"))
+        prev = x
+    return out
+
+
+def comparison_points(measured: pd.DataFrame, predicted: pd.DataFrame, value: str) -> pd.DataFrame:
+    """Join measured and predicted values point by point.
+
+    Both frames carry ``specimen_id`` and, for curves, ``step``; ``value`` names the compared
+    column (``twist_arcmin`` or ``lost_motion_arcmin``...). Returns D, S, E = S − D and u_D
+    (from ``u_twist_arcmin`` / ``u_arcmin`` when the data give it, else NaN).
+    """
+    keys = ["specimen_id"] + (["step"] if "step" in measured.columns and "step" in predicted.columns else [])
+    u_col = next((c for c in ("u_twist_arcmin", "u_arcmin") if c in measured.columns), None)
+    left = measured.rename(columns={value: "D"})
+    right = predicted[keys + [value]].rename(columns={value: "S"})
+    pts = left.merge(right, on=keys, how="left", validate="one_to_one")
+    missing = pts["S"].isna()
+    if missing.any():
+        raise ValueError(f"no prediction for {int(missing.sum())} measured point(s), e.g. specimen "
+                         f"{pts.loc[missing, 'specimen_id'].iloc[0]!r}")
+    pts["E"] = pts["S"] - pts["D"]
+    pts["u_D"] = pts[u_col] if u_col else np.nan
+    if "torque_Nm" in pts.columns and "step" in keys:
+        pts = pts.sort_values(keys).reset_index(drop=True)
+        pts["branch"] = np.concatenate([branches(g["torque_Nm"].to_numpy()) for _, g in
+                                        pts.groupby("specimen_id", sort=False)])
+    return pts
+
+
+@dataclass(frozen=True)
+class Summary:
+    n: int
+    rmse: float
+    bias: float
+    max_abs: float
+    worst_specimen: str
+    u_val: float          # root-mean-square validation uncertainty (NaN without noise information)
+    share_beyond_2uval: float  # share of points with |E| > 2 u_val (NaN without noise information)
+
+
+def summarise(points: pd.DataFrame, u_num: float = 0.0, u_input: float = 0.0) -> tuple[Summary, pd.DataFrame]:
+    """Overall figures and one row per specimen (rmse, bias, largest |E|)."""
+    E = points["E"].to_numpy(float)
+    per = points.groupby("specimen_id", sort=False)["E"].agg(
+        rmse_arcmin=lambda e: float(np.sqrt(np.mean(np.square(e)))), bias_arcmin="mean",
+        max_abs_arcmin=lambda e: float(np.max(np.abs(e))), n="size").reset_index()
+    u_D = points["u_D"].to_numpy(float)
+    u_val = np.sqrt(u_num ** 2 + u_input ** 2 + u_D ** 2)
+    has_noise = np.isfinite(u_val).all()
+    summary = Summary(n=len(E), rmse=float(np.sqrt(np.mean(E ** 2))), bias=float(E.mean()),
+                      max_abs=float(np.abs(E).max()),
+                      worst_specimen=str(per.sort_values("rmse_arcmin").iloc[-1]["specimen_id"]),
+                      u_val=float(np.sqrt(np.mean(u_val ** 2))) if has_noise else float("nan"),
+                      share_beyond_2uval=float(np.mean(np.abs(E) > 2 * u_val)) if has_noise else float("nan"))
+    return summary, per.sort_values("rmse_arcmin", ascending=False).reset_index(drop=True)
+
+
+def residual_tests(points: pd.DataFrame) -> pd.DataFrame:
+    """statsmodels tests on the comparison error, with p-values (small p: a pattern the model misses)."""
+    rows = []
+    spec = points.groupby("specimen_id", sort=False).agg(E=("E", "mean"), **{c: (c, "first") for c in PARAMETER_COLUMNS})
+    X = spec[list(PARAMETER_COLUMNS)].to_numpy(float)
+    varying = X.std(axis=0) > 0
+    if len(spec) > varying.sum() + 2 and varying.any():
+        fit = sm.OLS(spec["E"].to_numpy(float), sm.add_constant(X[:, varying])).fit()
+        rows.append({"test": "error ~ inputs (OLS F-test)", "statistic": float(fit.fvalue), "p_value": float(fit.f_pvalue),
+                     "meaning": "the per-specimen error follows the design parameters"})
+        for name, p in zip(np.array(PARAMETER_COLUMNS)[varying], fit.pvalues[1:]):
+            rows.append({"test": f"error ~ inputs: {name}", "statistic": float("nan"), "p_value": float(p),
+                         "meaning": f"the error changes with {name}"})
+    if len(points) > 5 and points["S"].std() > 0:
+        base = sm.OLS(points["D"].to_numpy(float), sm.add_constant(points["S"].to_numpy(float))).fit()
+        reset = linear_reset(base, power=3, use_f=True)
+        rows.append({"test": "RESET on measured ~ predicted", "statistic": float(reset.statistic),
+                     "p_value": float(reset.pvalue), "meaning": "measured and predicted are not linearly related"})
+    if "branch" in points.columns and "torque_Nm" in points.columns:
+        design = pd.get_dummies(points["branch"], drop_first=True, dtype=float)
+        design["abs_torque"] = points["torque_Nm"].abs()
+        fit = sm.OLS(points["E"].to_numpy(float), sm.add_constant(design.to_numpy(float))).fit()
+        rows.append({"test": "error ~ |torque| + branch (OLS F-test)", "statistic": float(fit.fvalue),
+                     "p_value": float(fit.f_pvalue), "meaning": "the error depends on where along the curve"})
+    return pd.DataFrame(rows, columns=["test", "statistic", "p_value", "meaning"])
+
+
+def bic(rss: float, n: int, k: int) -> float:
+    """Bayesian information criterion of a Gaussian least-squares fit with k free parameters."""
+    return n * np.log(max(rss, 1e-300) / n) + k * np.log(n)
+
+
+@dataclass(frozen=True)
+class Candidate:
+    effect: str
+    params: dict
+    rss: float
+    n: int
+    k: int            # calibrated parameters
+    loo_rmse: float   # leave-one-specimen-out error
+
+    @property
+    def rmse(self) -> float:
+        return float(np.sqrt(self.rss / self.n))
+
+
+def verdict(baseline: Candidate, candidates: list[Candidate], pay_threshold: float = 10.0,
+            tie_threshold: float = 6.0) -> dict:
+    """Rank candidates by ΔBIC against the baseline and decide.
+
+    A candidate *pays* when ΔBIC ≤ −``pay_threshold`` (10: very strong evidence, Kass &
+    Raftery 1995) and its leave-one-out error is below the baseline's. The missing effect
+    is the paying candidate of lowest BIC; paying candidates within ``tie_threshold`` of it
+    (less than strong evidence to prefer it) are reported as indistinguishable.
+    """
+    b0 = bic(baseline.rss, baseline.n, baseline.k)
+    ranking = []
+    for c in candidates:
+        d = bic(c.rss, c.n, c.k) - b0
+        ranking.append({"effect": c.effect, "params": c.params, "rmse_arcmin": c.rmse, "delta_bic": float(d),
+                        "loo_rmse_arcmin": c.loo_rmse,
+                        "pays": bool(d <= -pay_threshold and c.loo_rmse < baseline.loo_rmse)})
+    ranking.sort(key=lambda r: r["delta_bic"])
+    paying = [r for r in ranking if r["pays"]]
+    if not paying:
+        return {"baseline": {"rmse_arcmin": baseline.rmse, "loo_rmse_arcmin": baseline.loo_rmse},
+                "ranking": ranking, "verdict": {"missing_effect": None, "indistinguishable_from": [],
+                                                "text": "no missing effect found"}}
+    best = paying[0]
+    ties = [r["effect"] for r in paying[1:] if r["delta_bic"] - best["delta_bic"] < tie_threshold]
+    text = f"{best['effect']} is missing" + (f"; the data cannot tell it from {', '.join(ties)}" if ties else "")
+    return {"baseline": {"rmse_arcmin": baseline.rmse, "loo_rmse_arcmin": baseline.loo_rmse}, "ranking": ranking,
+            "verdict": {"missing_effect": best["effect"], "indistinguishable_from": ties, "text": text}}
+
+
+def summary_dict(summary: Summary) -> dict:
+    return asdict(summary)

@@ -1,0 +1,71 @@
+"""Comparison statistics and the verdict logic of hdwf.validation."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hdwf.validation import Candidate, bic, branches, comparison_points, residual_tests, summarise, verdict
+
+TORQUES = [0.0, 0.48, 0.96, 0.48, 0.0, -0.48, -0.96, -0.48, 0.0]
+
+
+def test_branches_of_the_test_sequence():
+    assert branches(TORQUES) == ["load+", "load+", "load+", "unload+", "unload+", "load-", "load-", "unload-",
+                                 "unload-"]
+
+
+def _points(bias=0.0, slope_in_rfs=0.0, noise=0.0, n_spec=12, seed=0):
+    rng = np.random.default_rng(seed)
+    meas, pred = [], []
+    for s in range(n_spec):
+        rfs = 0.002 * s
+        for k, t in enumerate(TORQUES):
+            S = 0.3 * np.sign(t) + 0.1 * t
+            D = S - bias - slope_in_rfs * rfs + noise * rng.normal()
+            common = {"specimen_id": f"S{s}", "step": k, "d_mm": 31.0 + 0.001 * (s % 3), "D_mm": 42.0 - 0.001 * (s % 4),
+                      "Gr_mm": 0.01 + 0.001 * (s % 5), "rFS_mm": rfs, "rCS_mm": 0.01 + 0.001 * (s % 2)}
+            meas.append({**common, "torque_Nm": t, "twist_arcmin": D, "u_twist_arcmin": max(noise, 1e-3)})
+            pred.append({"specimen_id": f"S{s}", "step": k, "twist_arcmin": S})
+    return comparison_points(pd.DataFrame(meas), pd.DataFrame(pred), "twist_arcmin")
+
+
+def test_comparison_error_and_summary():
+    pts = _points(bias=0.05)
+    assert np.allclose(pts["E"], 0.05)  # E = S - D
+    s, per = summarise(pts)
+    assert s.rmse == pytest.approx(0.05) and s.bias == pytest.approx(0.05) and s.max_abs == pytest.approx(0.05)
+    assert len(per) == 12
+
+
+def test_validation_uncertainty_by_vv20():
+    pts = _points(noise=0.02)
+    s, _ = summarise(pts, u_num=0.01, u_input=0.0)
+    assert s.u_val == pytest.approx(np.sqrt(0.01 ** 2 + 0.02 ** 2))
+    # Gaussian noise only: about 5 % of the points beyond 2 u_D, far fewer than a model error gives
+    assert s.share_beyond_2uval < 0.15
+
+
+def test_residual_tests_find_a_trend_in_an_input_and_not_in_noise():
+    trend = residual_tests(_points(slope_in_rfs=20.0, noise=0.01)).set_index("test")
+    assert trend.loc["error ~ inputs: rFS_mm", "p_value"] < 1e-3
+    clean = residual_tests(_points(noise=0.01, seed=3)).set_index("test")
+    assert clean.loc["error ~ inputs (OLS F-test)", "p_value"] > 0.01
+
+
+def test_bic_prefers_the_true_model():
+    # BIC = n ln(RSS/n) + k ln n: one extra parameter must buy a factor exp(ln n / n) of RSS.
+    assert bic(1.0, 100, 2) - bic(1.0, 100, 1) == pytest.approx(np.log(100))
+    assert bic(0.5, 100, 2) < bic(1.0, 100, 1)
+
+
+def test_verdict_names_the_effect_ties_and_none():
+    base = Candidate("baseline", {}, rss=1.0, n=200, k=0, loo_rmse=0.071)
+    strong = Candidate("tooth_friction", {"mu": 0.08}, rss=0.2, n=200, k=1, loo_rmse=0.032)
+    twin = Candidate("cs_housing", {"k": 1e5}, rss=0.205, n=200, k=1, loo_rmse=0.033)
+    weak = Candidate("thermal", {"dT": 1.0}, rss=0.99, n=200, k=1, loo_rmse=0.070)
+    v = verdict(base, [weak, twin, strong])
+    assert v["verdict"]["missing_effect"] == "tooth_friction"
+    assert v["verdict"]["indistinguishable_from"] == ["cs_housing"]
+    assert [r["effect"] for r in v["ranking"]] == ["tooth_friction", "cs_housing", "thermal"]
+    none = verdict(base, [weak])
+    assert none["verdict"]["missing_effect"] is None and "no missing effect" in none["verdict"]["text"]
