@@ -1,12 +1,16 @@
 """Time one HD 42 design (Table 4, set 8) at the default mesh: median of 3 solves.
 
 Run with one thread, e.g.  OMP_NUM_THREADS=1 python benchmarks/bench_solve.py
+Options: a positional refinement (default 1.0), ``--symmetry full|half`` (default full:
+the half model uses the drive's 180 deg point symmetry), ``--unit hd42|hd120`` (HD 120
+Table 5 set 8) and ``--repeats N``.
 Prints mesh time, solve_s, factorize_s (one factorisation of every body's stiffness),
 their ratio, Phi and the peak resident memory of the process (resource.getrusage).
 """
 
 from __future__ import annotations
 
+import argparse
 import os
 import resource
 import statistics
@@ -27,11 +31,20 @@ from hdwf.geometry import drive_geometry  # noqa: E402
 from hdwf.mesh import build_mesh  # noqa: E402
 
 
-def main(repeats: int = 3, refinement: float = 1.0) -> None:
-    g = drive_geometry("hd42", 31.0151111111, 41.992, 0.0152777778, 0.0144444444,
-                       0.0188888889)
+DESIGNS = {
+    "hd42": (("hd42", 31.0151111111, 41.992, 0.0152777778, 0.0144444444, 0.0188888889),
+             "HD 42 Table 4 set 8 (paper Phi 1.487 arcmin)"),
+    "hd120": (("hd120", 90.020777778, 119.989, 0.024666667, 0.046666667, 0.053333333),
+              "HD 120 Table 5 set 8"),
+}
+
+
+def main(repeats: int = 3, refinement: float = 1.0, symmetry: str = "full",
+         unit: str = "hd42") -> None:
+    args, label = DESIGNS[unit]
+    g = drive_geometry(*args)
     t0 = time.perf_counter()
-    mesh = build_mesh(g, refinement=refinement)
+    mesh = build_mesh(g, refinement=refinement, symmetry=symmetry)
     mesh_s = time.perf_counter() - t0
     runs = []
     for _ in range(repeats):
@@ -44,7 +57,7 @@ def main(repeats: int = 3, refinement: float = 1.0) -> None:
     fact = statistics.median(r.factorize_s for r in runs)
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     r = runs[0]
-    print(f"design            HD 42 Table 4 set 8 (paper Phi 1.487 arcmin)")
+    print(f"design            {label}, symmetry {symmetry}")
     print(f"nodes / dofs      {mesh.n_nodes} / {r.n_dofs}")
     print(f"mesh_s            {mesh_s:.2f}")
     print(f"solve_s (median)  {solve:.2f}   (includes assembly + factorisation)")
@@ -58,4 +71,10 @@ def main(repeats: int = 3, refinement: float = 1.0) -> None:
 
 
 if __name__ == "__main__":
-    main(refinement=float(sys.argv[1]) if len(sys.argv) > 1 else 1.0)
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("refinement", nargs="?", type=float, default=1.0)
+    ap.add_argument("--symmetry", choices=("full", "half"), default="full")
+    ap.add_argument("--unit", choices=tuple(DESIGNS), default="hd42")
+    ap.add_argument("--repeats", type=int, default=3)
+    a = ap.parse_args()
+    main(repeats=a.repeats, refinement=a.refinement, symmetry=a.symmetry, unit=a.unit)

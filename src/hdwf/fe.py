@@ -54,6 +54,23 @@ teeth are apart) is closed by adding the first pair that closes along that mode.
 Cost: one factorisation per body plus back-solves, a handful of dense KKT solves per
 load step.  A run that does not converge returns status "failed" with a reason.
 
+Half model (``mesh.symmetry == "half"``, hand-written): the drive and its load are
+invariant under the rotation by pi about the axis (even tooth and ball counts, pi-periodic
+cam, torque), so the solution satisfies u(-x) = -u(x) and only the upper half of every
+body is meshed (``hdwf.mesh``).  On the cut every node at (-x, 0) is tied to its partner
+at (x, 0), u = -u_partner: body dofs u = P u_red, and K_red = P^T K P is what is
+factorised (``_solve_body`` maps forces by P^T and displacements by P, so the watch
+vector, the rows and the full fields keep the half-body node numbering).  The symmetric
+field has no translations, so a floating half body keeps only its rotation: one pinned
+tangential dof, and stage 1 has no free rigid mode at all.  Contacts cover angles
+[0, pi) only, each standing for itself and its image: balls 0 .. n/2-1 (ball 0 on the
+cut), fit bins over [0, pi), cam rows and tooth slave nodes on the half; the tied nodes
+at angle pi are left out of every row (their rows would repeat their partners'), and a
+ball patch or fit bin reaching below angle 0 uses the images near pi (same radial
+motion).  The half rim carries T/2 (``f_scale``) while the twist measure stays the mean
+rotation of the rim, so the twist equals the full model's; the tooth count is doubled.
+Both models give the same Phi to mesh noise (two different gmsh meshes of one density).
+
 The frictionless FS is indifferent inside the backlash at zero torque; zero-torque steps
 use 1e-3 of the test torque in the direction of the last load (the state an
 infinitesimally small friction would leave), documented in the result.
@@ -206,6 +223,8 @@ class _Body:
     watch_nodes: np.ndarray         # body node ids whose dofs are watched
     wofs: int = 0                   # offset of this body in the watch vector
     wpos: np.ndarray | None = None  # node id -> position in watch vector (2 per node) or -1
+    P: sp.csr_matrix | None = None  # half model: body dofs = P @ reduced dofs (cut ties)
+    dep: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))  # tied nodes
 
     @property
     def x(self):
@@ -222,15 +241,66 @@ def _pin_nodes(p: np.ndarray, boundary: np.ndarray, r_mid: float):
     return a, b
 
 
+def _symmetry_map(p: np.ndarray, nd: np.ndarray):
+    """Half model: tie every cut node at (-x, 0) to its partner at (x, 0), u = -u_partner.
+
+    Returns P (ndof x nred, body dofs = P @ reduced dofs) and the tied (eliminated) nodes.
+    """
+    scale = float(np.abs(p).max())
+    cut = np.abs(p[1]) <= 1e-9 * scale
+    right = np.flatnonzero(cut & (p[0] > 0))
+    left = np.flatnonzero(cut & (p[0] < 0))
+    right = right[np.argsort(p[0, right])]
+    left = left[np.argsort(-p[0, left])]
+    if right.size != left.size or right.size == 0 or np.abs(
+            p[0, right] + p[0, left]).max() > 1e-7 * scale:
+        raise ValueError("half model: the cut nodes at angle 0 and pi do not pair up")
+    ndof = 2 * p.shape[1]
+    keep = np.ones(p.shape[1], bool)
+    keep[left] = False
+    red = -np.ones(ndof, dtype=np.int64)
+    kd = np.sort(np.concatenate([nd[0, keep], nd[1, keep]]))
+    red[kd] = np.arange(kd.size)
+    sgn = np.ones(ndof)
+    for c in (0, 1):
+        red[nd[c, left]] = red[nd[c, right]]
+        sgn[nd[c, left]] = -1.0
+    P = sp.csr_matrix((sgn, (np.arange(ndof), red)), shape=(ndof, kd.size))
+    return P, left
+
+
 def _make_body(name: str, bm: BodyMesh, E: float, nu: float, fixed_nodes=None,
-               watch_nodes=None) -> tuple[_Body, float]:
+               watch_nodes=None, half: bool = False) -> tuple[_Body, float]:
     K, basis = assemble_stiffness(bm, E, nu)
     nd = basis.nodal_dofs
     p = bm.mesh.p
     ndof = K.shape[0]
     modes = {}
+    P, dep = None, np.zeros(0, dtype=np.int64)
+    Kr = K
+    if half:
+        P, dep = _symmetry_map(p, nd)
+        Kr = (P.T @ K @ P).tocsr()
+        red = P.indices                      # reduced dof of every body dof (one entry a row)
     if fixed_nodes is not None:
         fixed = np.concatenate([nd[0, fixed_nodes], nd[1, fixed_nodes]])
+        if half:
+            fixed = np.unique(red[fixed])
+    elif half:
+        # the symmetric field has no translations; only the rotation is pinned, by the
+        # tangential dof of an interior node on the y axis
+        on_cut = np.flatnonzero(np.abs(p[1]) <= 1e-9 * np.abs(p).max())
+        bnd = np.concatenate(list(bm.node_sets.values()) + [on_cut])
+        r = np.hypot(p[0], p[1])
+        r_mid = 0.5 * (r.min() + r.max())
+        mask = np.ones(p.shape[1], bool)
+        mask[bnd] = False
+        idx = np.flatnonzero(mask)
+        a = idx[np.argmin(p[0, idx] ** 2 + (p[1, idx] - r_mid) ** 2)]
+        fixed = np.array([red[nd[0, a]]])
+        v = np.zeros(ndof)
+        v[nd[0]], v[nd[1]] = -p[1], p[0]
+        modes["rot"] = v
     else:
         bnd = np.concatenate(list(bm.node_sets.values()))
         r = np.hypot(p[0], p[1])
@@ -242,12 +312,12 @@ def _make_body(name: str, bm: BodyMesh, E: float, nu: float, fixed_nodes=None,
             v = np.zeros(ndof)
             v[nd[0]], v[nd[1]] = vx, vy
             modes[mname] = v
-    free = np.setdiff1d(np.arange(ndof), fixed)
+    free = np.setdiff1d(np.arange(Kr.shape[0]), fixed)   # reduced dofs in the half model
     t0 = time.perf_counter()
-    lu = splu(K[free][:, free].tocsc(), permc_spec="COLAMD")
+    lu = splu(Kr[free][:, free].tocsc(), permc_spec="COLAMD")
     tf = time.perf_counter() - t0
     wn = np.unique(np.asarray(watch_nodes, dtype=np.int64))
-    return _Body(name, bm, K, nd, free, lu, modes, wn), tf
+    return _Body(name, bm, K, nd, free, lu, modes, wn, P=P, dep=dep), tf
 
 
 # --------------------------------------------------------------------------------------
@@ -351,6 +421,11 @@ class LostMotionModel:
         self.debug = False
         self.add_min, self.add_frac = 5, 0.2
         self.n_bins = n_bins
+        self.half = (getattr(mesh, "symmetry", "full") == "half"
+                     or float(mesh.sizes.get("symmetry_half", 0.0)) == 1.0)
+        # half model: the half rim carries half the torque; the twist measure (mean rotation
+        # of the rim) is the same for the half and the whole
+        self.f_scale = 0.5 if self.half else 1.0
         bms = mesh.bodies
         # watch sets: every contact node (teeth only in the engagement zones)
         def zone(bm, nodes):
@@ -367,7 +442,7 @@ class LostMotionModel:
         for name, w, fixed in (("fs", fs_w, None),
                                ("cs", cs_w, bms["cs"].node_sets["cs_outer"]),
                                ("ir", ir_w, None), ("or", or_w, None)):
-            b, tf = _make_body(name, bms[name], self.E, geom.nu, fixed, w)
+            b, tf = _make_body(name, bms[name], self.E, geom.nu, fixed, w, self.half)
             self.factorize_s += tf
             self.bodies[name] = b
         ofs = 0
@@ -393,8 +468,8 @@ class LostMotionModel:
         J = float(np.sum(w * (p[0] ** 2 + p[1] ** 2)))
         q = np.zeros(fs.K.shape[0])
         q[fs.nd[0]], q[fs.nd[1]] = -w * p[1] / J, w * p[0] / J
-        self.q = q                       # load per unit torque (N/(N mm)) and twist measure
-        self.uq = self._solve_body(fs, q[:, None])[:, 0]
+        self.q = q       # twist measure; load per unit torque is f_scale * q (N/(N mm))
+        self.uq = self.f_scale * self._solve_body(fs, q[:, None])[:, 0]
         self.uq_watch = self._watch_vec("fs", self.uq)
         self.qq = float(q @ self.uq)
         # rigid modes: (body, mode) -> column of R (watch restriction), twist, load
@@ -411,6 +486,11 @@ class LostMotionModel:
 
     # ---------------------------------------------------------------- linear algebra
     def _solve_body(self, b: _Body, F: np.ndarray) -> np.ndarray:
+        if b.P is not None:                  # half model: solve on the tied (reduced) dofs
+            Fr = np.asarray(b.P.T @ F)
+            Ur = np.zeros((b.P.shape[1], F.shape[1]))
+            Ur[b.free] = b.lu.solve(np.ascontiguousarray(Fr[b.free]))
+            return np.asarray(b.P @ Ur)
         U = np.zeros((b.K.shape[0], F.shape[1]))
         U[b.free] = b.lu.solve(np.ascontiguousarray(F[b.free]))
         return U
@@ -467,13 +547,13 @@ class LostMotionModel:
             R[:, j] = self._watch_vec(bn, v)
             if bn == "fs":
                 Rq[j] = self.q @ v
-                Rf[j] = self.q @ v     # R^T f per unit torque
+                Rf[j] = self.f_scale * (self.q @ v)     # R^T f per unit torque
         return R, Rq, Rf
 
     # ---------------------------------------------------------------- rows
     def cam_rows(self, u_watch: np.ndarray) -> _Rows:
         ir = self.bodies["ir"]
-        nodes = ir.bm.node_sets["ir_bore"]
+        nodes = self._indep(ir, ir.bm.node_sets["ir_bore"])
         X = ir.x[:, nodes]
         u = np.vstack([u_watch[ir.wpos[0, nodes]], u_watch[ir.wpos[1, nodes]]])
         x = X + u
@@ -506,32 +586,41 @@ class LostMotionModel:
     def ball_rows(self) -> _Rows:
         g = self.g
         ir, orr = self.bodies["ir"], self.bodies["or"]
-        thb = 2 * math.pi * np.arange(g.n_balls) / g.n_balls
+        # half model: the balls in [0, pi) (ball 0 on the cut, its image at pi implied);
+        # a patch reaching below angle 0 takes the images near pi (same radial motion)
+        nb = g.n_balls // 2 if self.half else g.n_balls
+        per = math.pi if self.half else 2 * math.pi
+        thb = 2 * math.pi * np.arange(nb) / g.n_balls
         def patches(b, nodes):
+            nodes = self._indep(b, nodes)
             th = np.arctan2(b.x[1, nodes], b.x[0, nodes])
-            h = 2 * math.pi / nodes.size
+            h = per / nodes.size
             out = []
             for t in thb:
-                d = np.abs(np.angle(np.exp(1j * (th - t))))
+                d = np.abs(np.angle(np.exp(2j * math.pi / per * (th - t)))) * per / (2 * math.pi)
                 out.append(nodes[d <= 1.01 * h])
             return out
         Gi = _radial_rows(ir, patches(ir, ir.bm.node_sets["ir_race"]), -1.0, self.nwatch)
         Go = _radial_rows(orr, patches(orr, orr.bm.node_sets["or_race"]), +1.0, self.nwatch)
-        return _Rows("ball", (Gi + Go).tocsr(), np.full(g.n_balls, g.ball_gap))
+        return _Rows("ball", (Gi + Go).tocsr(), np.full(nb, g.ball_gap))
 
     def fit_rows(self) -> _Rows:
         g = self.g
         fs, orr = self.bodies["fs"], self.bodies["or"]
+        # half model: the bins over [0, pi) only, nodes taken modulo pi (same bin width)
+        nbin = self.n_bins // 2 if self.half else self.n_bins
+        per = math.pi if self.half else 2 * math.pi
         def bins(b, nodes):
-            th = np.mod(np.arctan2(b.x[1, nodes], b.x[0, nodes]), 2 * math.pi)
-            k = np.floor(th / (2 * math.pi) * self.n_bins + 0.5).astype(int) % self.n_bins
-            return [nodes[k == i] for i in range(self.n_bins)]
+            nodes = self._indep(b, nodes)
+            th = np.mod(np.arctan2(b.x[1, nodes], b.x[0, nodes]), per)
+            k = np.floor(th / per * nbin + 0.5).astype(int) % nbin
+            return [nodes[k == i] for i in range(nbin)]
         bf, bo = bins(fs, fs.bm.node_sets["fs_bore"]), bins(orr, orr.bm.node_sets["or_outer"])
         if any(len(x) == 0 for x in bf + bo):
             raise ValueError("mortar bins without nodes: mesh too coarse for n_bins")
         G = (_radial_rows(fs, bf, +1.0, self.nwatch)
              + _radial_rows(orr, bo, -1.0, self.nwatch)).tocsr()
-        return _Rows("fit", G, np.full(self.n_bins, g.r_fs_bore - g.or_outer))
+        return _Rows("fit", G, np.full(nbin, g.r_fs_bore - g.or_outer))
 
     def tooth_rows(self, u_watch: np.ndarray, cand_gap: float,
                    nodes: np.ndarray | None = None) -> _Rows:
@@ -539,8 +628,8 @@ class LostMotionModel:
         configuration, kept if the gap there is below ``cand_gap``; with ``nodes`` the
         same slave nodes are re-paired and re-linearised (same rows, new geometry)."""
         fs, cs = self.bodies["fs"], self.bodies["cs"]
-        sn = (np.intersect1d(fs.bm.node_sets["fs_teeth"], fs.watch_nodes) if nodes is None
-              else np.asarray(nodes))
+        sn = (self._indep(fs, np.intersect1d(fs.bm.node_sets["fs_teeth"], fs.watch_nodes))
+              if nodes is None else np.asarray(nodes))
         xs = fs.x[:, sn] + np.vstack([u_watch[fs.wpos[0, sn]], u_watch[fs.wpos[1, sn]]])
         E = cs.bm.edge_sets["cs_teeth"]
         inz = (cs.wpos[0, E[:, 0]] >= 0) & (cs.wpos[0, E[:, 1]] >= 0)
@@ -582,8 +671,17 @@ class LostMotionModel:
                           shape=(k, self.nwatch))
         g0 = bg - G @ u_watch
         th = np.arctan2(fs.x[1, sn], fs.x[0, sn])
-        tooth = np.round(th / (2 * math.pi / self.g.z_fs)).astype(int) % self.g.z_fs
+        # half model: tooth z/2 is the image of tooth 0 (ids modulo z/2; count them twice)
+        zid = self.g.z_fs // 2 if self.half else self.g.z_fs
+        tooth = np.round(th / (2 * math.pi / self.g.z_fs)).astype(int) % zid
         return _Rows("tooth", G, g0, {"tooth": tooth, "nodes": sn})
+
+    @staticmethod
+    def _indep(b: _Body, nodes: np.ndarray) -> np.ndarray:
+        """Nodes without the tied cut nodes at angle pi (half model): their rows would
+        repeat those of their partners at angle 0."""
+        nodes = np.asarray(nodes)
+        return nodes if b.dep.size == 0 else nodes[~np.isin(nodes, b.dep)]
 
     # ---------------------------------------------------------------- working set
     def _all_rows(self):
@@ -645,7 +743,7 @@ class LostMotionModel:
         for name, b in self.bodies.items():
             F = self._watch_to_body(name, force_watch)
             if name == "fs":
-                F[:, 0] += T * self.q
+                F[:, 0] += T * self.f_scale * self.q
             u = self._solve_body(b, F)[:, 0]
             for j, (bn, mn) in enumerate(self.mode_list):
                 if bn == name:
@@ -670,7 +768,7 @@ class LostMotionModel:
         act |= {ids[j] for j in np.flatnonzero(gfree < -self.tol_gap)}
         pb = getattr(self, "_ball_p", None)
         if pb is None:
-            pb = np.full(self.g.n_balls, 1.0)
+            pb = np.full(self.rows["ball"].G.shape[0], 1.0)
         for hertz_it in range(40):
             s_ball = self.ball_c * np.maximum(pb, 1e-3) ** (-1.0 / 3.0)
             p_full, alpha, u, gap, conv = self._pdas(T, G, g0, ids, idpos, R, Rq, Rf, GR,
@@ -802,8 +900,9 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
     try:
         model = LostMotionModel(geom, mesh, E=E, max_iter=max_iter, tol_gap=tol_gap)
         # ---- stage 1: wave generator (no teeth), FS rotation pinned
-        model.mode_list = [("fs", "tx"), ("fs", "ty"), ("ir", "tx"), ("ir", "ty"),
-                           ("or", "tx"), ("or", "ty")]
+        # (the half model's symmetric field has no translations: no modes in stage 1)
+        model.mode_list = [] if model.half else [("fs", "tx"), ("fs", "ty"), ("ir", "tx"),
+                                                 ("ir", "ty"), ("or", "tx"), ("or", "ty")]
         model.rows["ball"] = model.ball_rows()
         model.rows["fit"] = model.fit_rows()
         u = np.zeros(model.nwatch)
@@ -873,6 +972,8 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
                 ti = [i for (kk, i) in st["ids"] if kk == "tooth"]
                 pt = st["p"][kinds == "tooth"]
                 tooth_count = int(np.unique(tr.info["tooth"][np.array(ti)[pt > 0]]).size)
+                if model.half:
+                    tooth_count *= 2             # every tooth has its image at +pi
         tw = np.array(twists) / ARCMIN
         tw = tw - tw[0]
         kp = int(np.argmin(np.abs(frac - 1.0)))

@@ -19,6 +19,15 @@ the rim grades to about twice that size at the FS bore and to a coarse size at t
 outer rim.  ``refinement`` multiplies every element count (divides every size).
 Hand-written parts: only the tooth outlines (involute points from ``hdwf.geometry``) and
 the conversion of gmsh's arrays into per-body scikit-fem meshes.
+
+Half model (``symmetry="half"``): the drive is point-symmetric under a rotation by pi
+(even tooth counts, two-lobe cam, even ball count), so only the upper half (angles 0..pi)
+of every body is meshed.  Each body is cut along the x axis; the cut line at angle pi is
+made gmsh-periodic to the one at angle 0 under the rotation by pi, so every node at
+(-x, 0) has a partner at (x, 0) (``hdwf.fe`` ties them, u_partner = -u).  The half
+outlines use the same points, flank and arc node counts as the full ones, so the density
+rule is unchanged.  ``DriveMesh.symmetry`` says which model it is; the flag is also
+recorded as ``sizes["symmetry_half"] = 1.0`` so that it survives storage of ``sizes``.
 """
 
 from __future__ import annotations
@@ -48,6 +57,12 @@ class BodyMesh:
 class DriveMesh:
     bodies: dict[str, BodyMesh]
     sizes: dict[str, float]
+    symmetry: str = "full"                 # "full" or "half" (upper half, angles 0..pi)
+
+    def __post_init__(self):
+        # a mesh read back from storage carries only ``sizes``: the flag lives there too
+        if float(self.sizes.get("symmetry_half", 0.0)) == 1.0:
+            self.symmetry = "half"
 
     @property
     def n_nodes(self) -> int:
@@ -110,6 +125,47 @@ def _toothed_outline(geo, z: int, rr: np.ndarray, half_angle: np.ndarray, c: int
     return curves, flanks
 
 
+def _toothed_half_outline(geo, z: int, rr: np.ndarray, half_angle: np.ndarray, c: int,
+                          size: float):
+    """Upper half (angles 0..pi) of ``_toothed_outline``: the same points, starting at the
+    middle of period 0 (angle 0, radius rr[-1]) and ending at the middle of period z/2
+    (angle pi).  Returns (curves, flanks, first point, last point)."""
+    zh = z // 2
+    curves, flanks = [], []
+    rc = float(rr[-1])
+    p0 = geo.addPoint(rc, 0.0, 0.0, size)
+    pe = None
+    prev = None
+    for i in range(zh + 1):
+        th = 2 * math.pi * i / z
+        if i > 0:
+            pa = [geo.addPoint(r * math.cos(t), r * math.sin(t), 0.0, size)
+                  for r, t in zip(rr, th - half_angle)]
+            curves.append(geo.addCircleArc(prev, c, pa[0]))
+            fa = geo.addSpline(pa)
+            curves.append(fa)
+            flanks.append(fa)
+            if i == zh:
+                pe = geo.addPoint(-rc, 0.0, 0.0, size)
+                curves.append(geo.addCircleArc(pa[-1], c, pe))
+                break
+        pb = [geo.addPoint(r * math.cos(t), r * math.sin(t), 0.0, size)
+              for r, t in zip(rr[::-1], (th + half_angle)[::-1])]
+        curves.append(geo.addCircleArc(p0 if i == 0 else pa[-1], c, pb[0]))
+        fb = geo.addSpline(pb)
+        curves.append(fb)
+        flanks.append(fb)
+        prev = pb[-1]
+    return curves, flanks, p0, pe
+
+
+def _half_circle(geo, r: float, size: float, c: int):
+    """Upper half circle as 2 arcs 0 -> pi/2 -> pi (the full circle's first two arcs)."""
+    pts = [geo.addPoint(r * math.cos(a), r * math.sin(a), 0.0, size)
+           for a in np.arange(3) * math.pi / 2]
+    return [geo.addCircleArc(pts[0], c, pts[1]), geo.addCircleArc(pts[1], c, pts[2])], pts
+
+
 def _fs_outline(geo, g: DriveGeometry, c: int, s: dict) -> tuple[list[int], list[int]]:
     """Outer outline of the FS: teeth centred on 2 pi i / z_FS, flanks root -> tip."""
     rr = _flank_radii(g.r_fs_root, g.r_fs_tip, 12)
@@ -125,9 +181,17 @@ def _cs_outline(geo, g: DriveGeometry, c: int, s: dict) -> tuple[list[int], list
 
 def build_mesh(geom: DriveGeometry, elements_over_height: int = 10,
                elements_over_thickness: int = 6, refinement: float = 1.0,
-               path: str | None = None) -> DriveMesh:
-    """Mesh the four bodies; write ``path`` (.msh) if given; return per-body meshes."""
+               path: str | None = None, symmetry: str = "full") -> DriveMesh:
+    """Mesh the four bodies; write ``path`` (.msh) if given; return per-body meshes.
+
+    ``symmetry="half"`` meshes only the upper half of every body (see the module
+    docstring); ``"full"`` (default) the whole drive."""
     g = geom
+    if symmetry not in ("full", "half"):
+        raise ValueError(f"symmetry must be 'full' or 'half', not {symmetry!r}")
+    half = symmetry == "half"
+    if half and (g.z_fs % 2 or g.z_cs % 2 or g.n_balls % 2):
+        raise ValueError("half model needs even tooth and ball counts (180 deg symmetry)")
     s = _sizes(g, elements_over_height, elements_over_thickness, refinement)
     gmsh.initialize(interruptible=False)
     try:
@@ -138,31 +202,43 @@ def build_mesh(geom: DriveGeometry, elements_over_height: int = 10,
         c = geo.addPoint(0, 0, 0, 1.0)
 
         groups: dict[str, tuple[int, list[int]]] = {}
-        # --- FS
-        fs_out, fs_fl = _fs_outline(geo, g, c, s)
-        fs_bore = _circle(geo, g.r_fs_bore, s["fs_bore"], c)
-        fs_surf = geo.addPlaneSurface([geo.addCurveLoop(fs_out), geo.addCurveLoop(fs_bore)])
-        groups["fs"] = (2, [fs_surf])
-        groups["fs_teeth"] = (1, fs_out)
-        groups["fs_bore"] = (1, fs_bore)
-        # --- CS
-        cs_in, cs_fl = _cs_outline(geo, g, c, s)
-        cs_outer = _circle(geo, g.r_cs_outer, s["cs_outer"], c)
-        cs_surf = geo.addPlaneSurface([geo.addCurveLoop(cs_outer), geo.addCurveLoop(cs_in)])
-        groups["cs"] = (2, [cs_surf])
-        groups["cs_teeth"] = (1, cs_in)
-        groups["cs_outer"] = (1, cs_outer)
-        # --- bearing rings
-        ir_bore = _circle(geo, g.ir_bore, s["ring"], c)
-        ir_race = _circle(geo, g.ir_race, s["ring"], c)
-        ir_surf = geo.addPlaneSurface([geo.addCurveLoop(ir_race), geo.addCurveLoop(ir_bore)])
-        or_race = _circle(geo, g.or_race, s["ring"], c)
-        or_outer = _circle(geo, g.or_outer, s["ring"], c)
-        or_surf = geo.addPlaneSurface([geo.addCurveLoop(or_outer), geo.addCurveLoop(or_race)])
-        groups.update({"ir": (2, [ir_surf]), "ir_bore": (1, ir_bore), "ir_race": (1, ir_race),
-                       "or": (2, [or_surf]), "or_race": (1, or_race),
-                       "or_outer": (1, or_outer)})
+        cuts: list[tuple[int, int]] = []     # (line at angle pi, line at angle 0)
+        if half:
+            fs_fl, cs_fl, fs_bore, ir_bore, ir_race, or_race, or_outer, cs_outer = \
+                _half_geometry(geo, g, c, s, groups, cuts)
+        else:
+            # --- FS
+            fs_out, fs_fl = _fs_outline(geo, g, c, s)
+            fs_bore = _circle(geo, g.r_fs_bore, s["fs_bore"], c)
+            fs_surf = geo.addPlaneSurface([geo.addCurveLoop(fs_out), geo.addCurveLoop(fs_bore)])
+            groups["fs"] = (2, [fs_surf])
+            groups["fs_teeth"] = (1, fs_out)
+            groups["fs_bore"] = (1, fs_bore)
+            # --- CS
+            cs_in, cs_fl = _cs_outline(geo, g, c, s)
+            cs_outer = _circle(geo, g.r_cs_outer, s["cs_outer"], c)
+            cs_surf = geo.addPlaneSurface([geo.addCurveLoop(cs_outer), geo.addCurveLoop(cs_in)])
+            groups["cs"] = (2, [cs_surf])
+            groups["cs_teeth"] = (1, cs_in)
+            groups["cs_outer"] = (1, cs_outer)
+            # --- bearing rings
+            ir_bore = _circle(geo, g.ir_bore, s["ring"], c)
+            ir_race = _circle(geo, g.ir_race, s["ring"], c)
+            ir_surf = geo.addPlaneSurface([geo.addCurveLoop(ir_race), geo.addCurveLoop(ir_bore)])
+            or_race = _circle(geo, g.or_race, s["ring"], c)
+            or_outer = _circle(geo, g.or_outer, s["ring"], c)
+            or_surf = geo.addPlaneSurface([geo.addCurveLoop(or_outer), geo.addCurveLoop(or_race)])
+            groups.update({"ir": (2, [ir_surf]), "ir_bore": (1, ir_bore), "ir_race": (1, ir_race),
+                           "or": (2, [or_surf]), "or_race": (1, or_race),
+                           "or_outer": (1, or_outer)})
         geo.synchronize()
+        fs_surf, cs_surf = groups["fs"][1][0], groups["cs"][1][0]
+        ir_surf, or_surf = groups["ir"][1][0], groups["or"][1][0]
+        # half model: the cut at angle pi is the image of the cut at angle 0 under the
+        # rotation by pi, so their nodes pair up exactly (u_pi = -u_0 in hdwf.fe)
+        rot_pi = [-1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
+        for slave, master in cuts:
+            gmsh.model.mesh.setPeriodic(1, [slave], [master], rot_pi)
 
         # transfinite flanks: exactly n_flank segments over the tooth height
         for cv in fs_fl + cs_fl:
@@ -225,7 +301,50 @@ def build_mesh(geom: DriveGeometry, elements_over_height: int = 10,
         }
     finally:
         gmsh.finalize()
-    return DriveMesh(bodies, s)
+    if half:
+        s["symmetry_half"] = 1.0
+    return DriveMesh(bodies, s, symmetry)
+
+
+def _half_geometry(geo, g: DriveGeometry, c: int, s: dict, groups: dict, cuts: list):
+    """Upper halves of the four bodies, each closed by two radial cut lines on the x axis
+    (inner -> outer radius at angle 0 and at angle pi); fills ``groups`` and ``cuts``."""
+    def cut_pair(p_in0, p_out0, p_in1, p_out1):
+        l0 = geo.addLine(p_in0, p_out0)
+        l1 = geo.addLine(p_in1, p_out1)
+        cuts.append((l1, l0))
+        return l0, l1
+
+    # --- FS: toothed outline 0 -> pi, bore pi -> 0
+    rr = _flank_radii(g.r_fs_root, g.r_fs_tip, 12)
+    fs_out, fs_fl, o0, o1 = _toothed_half_outline(geo, g.z_fs, rr, fs_half_angle(g, rr), c,
+                                                  s["tooth"])
+    fs_bore, bp = _half_circle(geo, g.r_fs_bore, s["fs_bore"], c)
+    l0, l1 = cut_pair(bp[0], o0, bp[2], o1)
+    loop = fs_out + [-l1] + [-a for a in fs_bore[::-1]] + [l0]
+    fs_surf = geo.addPlaneSurface([geo.addCurveLoop(loop)])
+    groups.update({"fs": (2, [fs_surf]), "fs_teeth": (1, fs_out), "fs_bore": (1, fs_bore)})
+    # --- CS: outer rim 0 -> pi, toothed inner outline pi -> 0
+    rr = _flank_radii(g.r_cs_tip, g.r_cs_root, 12)
+    cs_in, cs_fl, i0, i1 = _toothed_half_outline(geo, g.z_cs, rr, cs_half_space_angle(g, rr),
+                                                 c, s["tooth"])
+    cs_outer, op = _half_circle(geo, g.r_cs_outer, s["cs_outer"], c)
+    l0, l1 = cut_pair(i0, op[0], i1, op[2])
+    loop = [l0] + cs_outer + [-l1] + [-a for a in cs_in[::-1]]
+    cs_surf = geo.addPlaneSurface([geo.addCurveLoop(loop)])
+    groups.update({"cs": (2, [cs_surf]), "cs_teeth": (1, cs_in), "cs_outer": (1, cs_outer)})
+    # --- bearing rings
+    def ring(r_in, r_out):
+        inner, ip = _half_circle(geo, r_in, s["ring"], c)
+        outer, op = _half_circle(geo, r_out, s["ring"], c)
+        l0, l1 = cut_pair(ip[0], op[0], ip[2], op[2])
+        loop = [l0] + outer + [-l1] + [-a for a in inner[::-1]]
+        return geo.addPlaneSurface([geo.addCurveLoop(loop)]), inner, outer
+    ir_surf, ir_bore, ir_race = ring(g.ir_bore, g.ir_race)
+    or_surf, or_race, or_outer = ring(g.or_race, g.or_outer)
+    groups.update({"ir": (2, [ir_surf]), "ir_bore": (1, ir_bore), "ir_race": (1, ir_race),
+                   "or": (2, [or_surf]), "or_race": (1, or_race), "or_outer": (1, or_outer)})
+    return fs_fl, cs_fl, fs_bore, ir_bore, ir_race, or_race, or_outer, cs_outer
 
 
 def annulus_mesh(r_in: float, r_out: float, size: float) -> BodyMesh:

@@ -159,18 +159,21 @@ def deformed_figure(mesh, fields: dict, title: str, path, half_width_mm: float, 
     plus, wg = fields["plus"], fields["wg"]
     values, polys = [], []
     ymax = half_width_mm
+    # A half model (180° point symmetry) holds angles 0..π; the rest is its image under p -> -p, u -> -u.
+    images = (1.0, -1.0) if getattr(mesh, "symmetry", "full") == "half" else (1.0,)
     for name, body in mesh.bodies.items():
-        p, t = body.mesh.p, body.mesh.t
-        x = p + magnify * plus[name]
-        centre = p[:, t].mean(axis=1)
-        keep = (centre[0] > xlim[0] - 0.5) & (centre[0] < xlim[1] + 0.5) & (np.abs(centre[1]) < ymax + 0.5)
-        tri = x[:, t[:, keep]].transpose(2, 1, 0)  # (n, 3, 2)
-        if name in ("fs", "cs"):
-            du = np.hypot(*_without_rotation(p, plus[name] - wg[name]))[t[:, keep]].mean(axis=0) * 1000.0
-            polys.append(tri)
-            values.append(du)
-        else:
-            ax.add_collection(PolyCollection(tri, facecolors="0.85", edgecolors="0.6", linewidths=0.1))
+        for sgn in images:
+            p, t = sgn * body.mesh.p, body.mesh.t
+            x = p + magnify * sgn * plus[name]
+            centre = p[:, t].mean(axis=1)
+            keep = (centre[0] > xlim[0] - 0.5) & (centre[0] < xlim[1] + 0.5) & (np.abs(centre[1]) < ymax + 0.5)
+            tri = x[:, t[:, keep]].transpose(2, 1, 0)  # (n, 3, 2)
+            if name in ("fs", "cs"):
+                du = np.hypot(*_without_rotation(p, sgn * (plus[name] - wg[name])))[t[:, keep]].mean(axis=0) * 1000.0
+                polys.append(tri)
+                values.append(du)
+            else:
+                ax.add_collection(PolyCollection(tri, facecolors="0.85", edgecolors="0.6", linewidths=0.1))
     coll = PolyCollection(np.concatenate(polys), array=np.concatenate(values), cmap="viridis",
                           edgecolors="k", linewidths=0.05)
     ax.add_collection(coll)

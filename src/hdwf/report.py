@@ -404,7 +404,8 @@ def _agreement_section(doc: Document, units, paper_files, ours_files, tmp: Path,
               "Agreement of our $Phi$ with the paper's at the 27 design points of Tables 4/5 ($R^2$ of a linear fit).")
     path = tmp / "agreement.png"
     agreement_figure(pairs, "hdwf FE vs the paper's Ansys FEA, same 27 designs", path)
-    doc.figure(path, "Our lost motion against the paper's at the same design points.")
+    doc.figure(path, "Our lost motion against the paper's at the same design points.",
+               width="100%" if len(pairs) > 1 else "55%")
     doc.text("The ranking is what the study needs (which parameters matter); the level differs by the median ratio "
              "above. Our 2D section has rigid-body flank backlash from $r_\"FS\"$, $r_\"CS\"$ with little preload "
              "to take it up; the paper's 3D model has more engaged teeth and a deflected cup.")
