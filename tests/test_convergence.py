@@ -30,7 +30,18 @@ def test_non_uniform_refinement_ratio():
 def test_oscillation_is_flagged():
     res = gci((0.5, 1.0, 2.0), (1.00, 1.02, 0.99))
     assert not res.monotone and math.isnan(res.p)
-    assert res.gci_fine == pytest.approx(1.5 * 0.03 / 1.00)
+    assert res.gci_fine == pytest.approx(3 * 0.02 / (2 - 1))  # safety 3, first order
+
+
+def test_pre_asymptotic_solutions_fall_back_and_say_so():
+    # Measured on an HD 120 design (meshes 0.1 / 0.125 / 0.2 mm): the fine pair changes 4x more
+    # than the coarse pair, which no order in [0.5, 10] explains (the iteration used to overflow).
+    res = gci((0.1, 0.125, 0.2), (9.64596332856317, 9.557819089373307, 9.537286356695542))
+    assert res.monotone and not res.asymptotic and math.isnan(res.p)
+    rel = abs(9.557819089373307 - 9.64596332856317) / 9.64596332856317
+    assert res.rel_change_fine == pytest.approx(rel)
+    assert res.gci_fine == pytest.approx(3 * rel / 0.25)
+    assert "asymptotic" in res.note
 
 
 def test_sizes_must_be_ordered():

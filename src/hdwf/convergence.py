@@ -2,9 +2,9 @@
 
 Celik et al. (2008), "Procedure for estimation and reporting of uncertainty due to
 discretization in CFD applications", J. Fluids Eng. 130, 078001 — the ASME procedure:
-three meshes with representative sizes h1 < h2 < h3, apparent order p from a fixed-point
-iteration, extrapolated value and GCI_fine = 1.25 e_a / (r^p - 1). Hand-written because it
-is a dozen lines and no maintained package offers it.
+three meshes with representative sizes h1 < h2 < h3, apparent order p, extrapolated value
+and GCI_fine = 1.25 e_a / (r^p - 1). Hand-written because it is a few lines and no
+maintained package offers it.
 """
 
 from __future__ import annotations
@@ -12,19 +12,32 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from scipy.optimize import brentq
+
 
 @dataclass(frozen=True)
 class GCIResult:
-    p: float                 # apparent order of convergence (nan when not monotone)
-    phi_extrapolated: float  # Richardson-extrapolated value (nan when not monotone)
+    p: float                 # apparent order of convergence (nan when it cannot be established)
+    phi_extrapolated: float  # Richardson-extrapolated value (nan without an order)
     rel_change_fine: float   # |phi1 - phi2| / |phi1|: the two finest meshes
     gci_fine: float          # GCI of the fine mesh, relative (0.01 = 1 %)
     monotone: bool           # False for oscillatory or stalled convergence
+    asymptotic: bool = True  # False when no order in [P_MIN, P_MAX] fits the three solutions
+    note: str = ""
 
 
-def gci(h: tuple[float, float, float], phi: tuple[float, float, float], safety: float = 1.25,
-        max_iter: int = 100) -> GCIResult:
-    """GCI of three solutions ``phi`` on meshes of size ``h`` (fine, medium, coarse)."""
+P_MIN, P_MAX = 0.5, 10.0
+CONSERVATIVE_P = 1.0  # contact problems converge at about first order; assumed when p is unknown
+
+
+def gci(h: tuple[float, float, float], phi: tuple[float, float, float], safety: float = 1.25) -> GCIResult:
+    """GCI of three solutions ``phi`` on meshes of size ``h`` (fine, medium, coarse).
+
+    The apparent order solves p ln r21 = |ln|e32/e21| + ln((r21^p - s)/(r32^p - s))| (Celik
+    Eq. 5) by bracketing in [P_MIN, P_MAX]. Without a root there (oscillating, stalled or
+    pre-asymptotic solutions) the GCI falls back to Roache's safety factor 3 with first order,
+    and says so.
+    """
     h1, h2, h3 = h
     f1, f2, f3 = phi
     if not h1 < h2 < h3:
@@ -32,19 +45,26 @@ def gci(h: tuple[float, float, float], phi: tuple[float, float, float], safety: 
     r21, r32 = h2 / h1, h3 / h2
     e21, e32 = f2 - f1, f3 - f2
     rel = abs(e21 / f1) if f1 != 0 else math.inf
+    fallback = 3.0 * rel / (r21 ** CONSERVATIVE_P - 1.0)
     if e21 == 0 or e32 == 0 or e32 / e21 < 0:
-        # Oscillating or stalled: no order can be inferred; Celik recommends a bound from
-        # the spread of the three solutions, with the safety factor 3 of Roache.
-        spread = (max(phi) - min(phi)) / abs(f1) if f1 != 0 else math.inf
-        return GCIResult(math.nan, math.nan, rel, 3.0 * spread / 2.0 if spread else 0.0, False)
+        return GCIResult(math.nan, math.nan, rel, fallback, False, False,
+                         "oscillating or stalled: GCI with safety factor 3 and first order")
     s = 1.0
-    p = abs(math.log(abs(e32 / e21))) / math.log(r21)
-    for _ in range(max_iter):
-        q = math.log((r21 ** p - s) / (r32 ** p - s))
-        p_new = abs(math.log(abs(e32 / e21)) + q) / math.log(r21)
-        if abs(p_new - p) < 1e-10:
-            p = p_new
+    ratio = math.log(abs(e32 / e21))
+
+    def residual(p):
+        return p * math.log(r21) - abs(ratio + math.log((r21 ** p - s) / (r32 ** p - s)))
+
+    grid = [P_MIN + k * (P_MAX - P_MIN) / 200 for k in range(201)]
+    values = [residual(p) for p in grid]
+    root = None
+    for a, b, fa, fb in zip(grid, grid[1:], values, values[1:]):
+        if fa == 0 or fa * fb < 0:
+            root = a if fa == 0 else brentq(residual, a, b, xtol=1e-12)
             break
-        p = p_new
-    ext = (r21 ** p * f1 - f2) / (r21 ** p - 1.0)
-    return GCIResult(p, ext, rel, safety * rel / (r21 ** p - 1.0), True)
+    if root is None:
+        return GCIResult(math.nan, math.nan, rel, fallback, True, False,
+                         f"not in the asymptotic range (no order in [{P_MIN}, {P_MAX}]): "
+                         "GCI with safety factor 3 and first order")
+    ext = (r21 ** root * f1 - f2) / (r21 ** root - 1.0)
+    return GCIResult(root, ext, rel, safety * rel / (r21 ** root - 1.0), True, True, "")

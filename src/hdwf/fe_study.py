@@ -197,7 +197,7 @@ def convergence_table(results: pd.DataFrame) -> pd.DataFrame:
             if len(sub) == 3:
                 g = gci(tuple(sub["h_mm"]), tuple(phi))
                 row.update({"gci_fine": g.gci_fine, "order_p": g.p, "phi_extrapolated_arcmin": g.phi_extrapolated,
-                            "monotone": g.monotone})
+                            "monotone": g.monotone, "asymptotic": g.asymptotic, "note": g.note})
         out.append(row)
     return pd.DataFrame(out)
 

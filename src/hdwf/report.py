@@ -343,7 +343,8 @@ def _convergence_section(doc: Document, units, files, level: int = 1):
         rows = []
         for r in conv.to_dict("records"):
             rows.append([lit(r["design_id"]), *[fmt(r.get(f"phi_{k}_arcmin"), 4) for k in levels],
-                         fmt(r.get("rel_change_fine", np.nan) * 100, 2), fmt(r.get("gci_fine", np.nan) * 100, 2),
+                         fmt(r.get("rel_change_fine", np.nan) * 100, 2),
+                         fmt(r.get("gci_fine", np.nan) * 100, 2) + ("\\*" if r.get("asymptotic") is False else ""),
                          fmt(r.get("order_p"), 2), "yes" if r["converged"] else "*no*"])
         first = conv.iloc[0]
         heads = [f"$Phi$ at {first.get(f'refinement_{k}', np.nan):g}×" for k in levels]
@@ -352,7 +353,9 @@ def _convergence_section(doc: Document, units, files, level: int = 1):
                   f"{UNIT_NAMES[u]}: $Phi$ (arcmin) on three meshes (every design on the two finest, representative "
                   f"designs also on the coarsest, which gives the GCI); {n_ok} of {len(conv)} designs converged; "
                   f"largest change {fmt(conv['rel_change_fine'].max() * 100, 2)} %, median GCI "
-                  f"{fmt(conv['gci_fine'].median() * 100 if 'gci_fine' in conv else np.nan, 2)} %.")
+                  f"{fmt(conv['gci_fine'].median() * 100 if 'gci_fine' in conv else np.nan, 2)} %. \\* no order of "
+                  "convergence in [0.5, 10] fits the three values (pre-asymptotic or oscillating): GCI with safety "
+                  "factor 3 and first order.")
 
 
 def _curves_section(doc: Document, units, files, tmp: Path, level: int = 1):
