@@ -313,7 +313,7 @@ def _sub(files: dict[str, str], study: str) -> dict[str, str]:
 
 
 def _fe_model_section(doc: Document, assumptions: list[dict] | None, pictures: dict[str, str] | None = None,
-                      level: int = 1):
+                      fe_settings: dict | None = None, level: int = 1):
     doc.heading("The FE model", level)
     doc.text("A 2D plane-stress section of each drive (gmsh mesh, scikit-fem assembly, linear-elastic steel, "
              "$E = 210$ GPa, $nu = 0.3$, thickness = face width) with unilateral frictionless contact between the "
@@ -321,6 +321,13 @@ def _fe_model_section(doc: Document, assumptions: list[dict] | None, pictures: d
              "$G_r$), the outer ring and the flexspline bore (fit from $D$) and the flexspline and circular-spline "
              "tooth flanks. The circular spline is held at its outer rim; the test torque acts on the flexspline. "
              "The contact solver is our own (see `hdwf.fe`).")
+    if fe_settings:
+        half = fe_settings.get("symmetry", "full") == "half"
+        doc.text(f"Settings: {fe_settings['elements_over_height']} elements over the tooth height and "
+                 f"{fe_settings['elements_over_thickness']} over its thickness (the paper's rule) times a refinement "
+                 f"of {fe_settings['refinement']:g}; {fe_settings['steps_per_ramp']} load steps per ramp; "
+                 + ("the half model (angles 0 to π tied by the drive's 180° point symmetry, which reproduces the "
+                    "full model's $Phi$ within 0.05 %, `docs/fe-model.md`)." if half else "the full model."))
     if assumptions:
         rows = [[lit(a["unit"]), lit(a["name"]), lit(a["value"]), lit(a["source"])] for a in assumptions]
         doc.table(["drive", "quantity", "value", "source or reason"], rows,
@@ -445,7 +452,7 @@ def _indices_vs_paper_section(doc: Document, units, data_dir, studies_files: dic
 
 
 def full_report(files: dict[str, str], studies: dict[str, dict], data_dir, provenance: dict, out,
-                assumptions: list[dict] | None = None) -> Path:
+                assumptions: list[dict] | None = None, fe_settings: dict | None = None) -> Path:
     """``results/report.pdf``: the paper replication, then our FE model and its studies.
 
     ``files`` keys are ``{study}__{unit}__{key}``; ``studies`` maps study name -> its config.
@@ -473,7 +480,7 @@ def full_report(files: dict[str, str], studies: dict[str, dict], data_dir, prove
         if fe_studies:
             doc.heading("Part II — our FE model", 1)
             pics = {UNIT_NAMES[k.split("__")[1]]: v for k, v in files.items() if k.endswith("__deformed_png")}
-            _fe_model_section(doc, assumptions, pics, 2)
+            _fe_model_section(doc, assumptions, pics, fe_settings, 2)
             conv = [s for s in fe_studies if any(k.startswith(f"{s}__") and k.endswith("__convergence") for k in files)]
             for study in conv:
                 _convergence_section(doc, studies[study]["units"], _sub(files, study), 2)

@@ -61,6 +61,7 @@ rule full_report:
         "results/report.pdf",
     params:
         studies=STUDIES,
+        fe_settings={k: v for k, v in FE.items() if k not in ("convergence", "picture")},
         data_dir=config["paper_data"],
         repo=REPO_DIR,
     log:
