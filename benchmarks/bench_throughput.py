@@ -31,12 +31,12 @@ def main():
             (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp / item)
         targets = [f"results/fe_at_paper/hd42/designs/paper-{i:02d}.parquet" for i in range(1, args.designs + 1)]
         meshes = [t.replace("/designs/", "/mesh/").replace(".parquet", ".npz") for t in targets]
-        subprocess.run([SNAKEMAKE, "--cores", "2", "--quiet", *meshes], cwd=tmp, check=True)
+        subprocess.run([SNAKEMAKE, *meshes, "--cores", "2", "--quiet"], cwd=tmp, check=True)
         times = {1: [], 2: []}
         for _ in range(args.repeats):
             for cores in (1, 2):
                 t0 = time.perf_counter()
-                subprocess.run([SNAKEMAKE, "--cores", str(cores), "--quiet", "--forcerun", "fe_solve", *targets],
+                subprocess.run([SNAKEMAKE, *targets, "--cores", str(cores), "--quiet", "--forcerun", "fe_solve"],
                                cwd=tmp, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
                 times[cores].append(time.perf_counter() - t0)
     m1, m2 = statistics.median(times[1]), statistics.median(times[2])
