@@ -55,8 +55,9 @@ def _check_relations(config: dict, source) -> None:
         if fe["refinement"] not in refs:
             raise ConfigError(source, f"must contain fe.refinement ({fe['refinement']}), the default mesh, as one of "
                               "the three meshes", field="fe.convergence.refinements", value=refs)
-        if fe["refinement"] != max(refs):
-            raise ConfigError(source, "the default mesh must be the finest of the three (the study runs on it)",
+        if fe["refinement"] == min(refs):
+            # The check compares the two finest meshes, so the study's own mesh must be one of them.
+            raise ConfigError(source, "the default mesh must be one of the two finest of the three",
                               field="fe.refinement", value=fe["refinement"])
         for key in ("convergence", "picture"):
             study = fe.get(key, {}).get("study")

@@ -202,12 +202,12 @@ def convergence_table(results: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(out)
 
 
-def convergence_stage(default_lost_motion, coarser_rows, default_refinement: float, out, provenance: dict,
+def convergence_stage(default_lost_motion, other_rows, default_refinement: float, out, provenance: dict,
                       meta: dict) -> pd.DataFrame:
     default = pd.read_parquet(default_lost_motion).assign(refinement=float(default_refinement))
-    coarse = pd.concat([pd.read_parquet(p) for p in coarser_rows], ignore_index=True)
+    others = pd.concat([pd.read_parquet(p) for p in other_rows], ignore_index=True)
     cols = ["design_id", "refinement", "h_tooth_mm", "lost_motion_arcmin"]
-    results = pd.concat([default[cols], coarse[cols]], ignore_index=True).rename(columns={"h_tooth_mm": "h_mm"})
+    results = pd.concat([default[cols], others[cols]], ignore_index=True).rename(columns={"h_tooth_mm": "h_mm"})
     return write_convergence(results, out, provenance, meta)
 
 

@@ -340,8 +340,8 @@ def _fe_model_section(doc: Document, assumptions: list[dict] | None, pictures: d
 
 def _convergence_section(doc: Document, units, files, level: int = 1):
     doc.heading("Mesh convergence", level)
-    doc.text("The designs of the `fe` study are solved on coarser meshes too (element density factors below; "
-             "the default is the finest). The grid convergence index (Celik et al. 2008) uses the tooth element size "
+    doc.text("The designs of the `fe` study are solved on other meshes too (element density factors below): every "
+             "design on the two finest, representative designs also on the third. The grid convergence index (Celik et al. 2008) uses the tooth element size "
              "as the mesh size; *change* is the relative difference of $Phi$ between the two finest meshes, "
              "required below 2 %.")
     for u in units:

@@ -82,7 +82,7 @@ rule fe_aggregate:
 
 
 rule fe_refined_solve:
-    # Mesh-convergence runs: mesh and solve one design at another refinement (not stored).
+    # Mesh-convergence runs: mesh and solve one design at another refinement (mesh not stored).
     input:
         "results/{study}/{unit}/designs.parquet",
     output:
@@ -103,13 +103,14 @@ rule fe_refined_solve:
 
 
 def _convergence_inputs(w):
-    """Every design on the second-finest mesh; every k-th also on the coarsest (for the GCI)."""
+    """Every design also on the other of the two finest meshes; every k-th also on the third (GCI)."""
     finest, second, coarsest = sorted(FE["convergence"]["refinements"], reverse=True)
+    pair_partner = finest if FE["refinement"] == second else second
     designs = design_ids(w.study, w.unit)
     every = FE["convergence"]["representative_every"]
     files = {"default": f"results/{w.study}/{w.unit}/lost_motion.parquet"}
-    files["coarser"] = [f"results/{w.study}/{w.unit}/convergence/r{second:g}/{d}.parquet" for d in designs]
-    files["coarser"] += [f"results/{w.study}/{w.unit}/convergence/r{coarsest:g}/{d}.parquet" for d in designs[::every]]
+    files["other_meshes"] = [f"results/{w.study}/{w.unit}/convergence/r{pair_partner:g}/{d}.parquet" for d in designs]
+    files["other_meshes"] += [f"results/{w.study}/{w.unit}/convergence/r{coarsest:g}/{d}.parquet" for d in designs[::every]]
     return files
 
 
