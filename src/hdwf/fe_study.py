@@ -18,7 +18,7 @@ import pandas as pd
 from . import PARAMETER_COLUMNS
 from .aggregate import write_lost_motion
 from .convergence import gci
-from .io import atomic_path, write_json, write_parquet
+from .io import atomic_path, write_parquet
 
 CURVE_COLUMNS = ["design_id", "step", "torque_Nm", "twist_arcmin"]
 
@@ -216,9 +216,6 @@ def write_convergence(results: pd.DataFrame, out, provenance: dict, meta: dict) 
     write_parquet(table, out, provenance=provenance, meta={**meta, "criterion": "two finest meshes differ < 2 %"})
     return table
 
-
-def write_run_summary(path, **facts) -> Path:
-    return write_json(facts, path)
 
 
 def deformed_stage(designs_path, design_id: str, unit: str, settings: dict, steps_per_ramp: int, out_png,

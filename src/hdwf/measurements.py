@@ -38,8 +38,6 @@ _WRONG_UNITS = {
     "twist": ("twist_arcmin", ["twist_deg", "twist_rad", "twist_arcsec", "twist_mrad", "twist_urad", "twist"]),
     "lost_motion": ("lost_motion_arcmin", ["lost_motion_deg", "lost_motion_arcsec", "lost_motion_rad"]),
 }
-# Rated torque T_N (paper Table 1); the test goes to ±4 % of it.
-RATED_TORQUE_NM = {"hd42": 24.0, "hd120": 529.0}
 # Table 3 bounds of each drive; the model is supported one span beyond them on each side,
 # and never for negative clearance or offsets (interference is outside the model's assumptions).
 _TABLE3 = {
@@ -47,6 +45,13 @@ _TABLE3 = {
     "hd120": {"d": (90.0, 90.022), "D": (119.978, 120.0), "Gr": (0.0, 0.055), "rFS": (0.025, 0.055),
               "rCS": (0.025, 0.055)},
 }
+
+
+def lost_motion_test_torque_Nm(unit: str) -> float:
+    """The test torque, 4 % of T_N, from the drive table of ``hdwf.geometry``."""
+    from .geometry import _UNIT_TABLE
+
+    return _UNIT_TABLE[unit].torque_Nmm / 1000.0
 
 
 def supported_bounds(unit: str) -> dict[str, tuple[float, float]]:
@@ -178,9 +183,9 @@ def _check_specimens(data: pd.DataFrame, form: str) -> list[tuple]:
         for i in rows.index[steps.duplicated().to_numpy()]:
             problems.append((i + 1, "step", data.at[i, "step"], f"duplicate step in specimen '{sid}'"))
         unit = rows["unit"].iloc[0]
-        if unit in RATED_TORQUE_NM and np.isfinite(rows["torque_Nm"]).all():
+        if unit in UNITS and np.isfinite(rows["torque_Nm"]).all():
             t = rows.sort_values("step")["torque_Nm"].to_numpy()
-            test = 0.04 * RATED_TORQUE_NM[unit]
+            test = lost_motion_test_torque_Nm(unit)
             if t.max() <= 0 or t.min() >= 0:
                 problems.append((first + 1, "torque_Nm", None, f"specimen '{sid}' does not load in both directions "
                                                                "(the test is 0 → +4 % T_N → 0 → −4 % T_N → 0)"))
