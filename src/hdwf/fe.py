@@ -22,11 +22,15 @@ Bodies and supports
 Contacts (unilateral, frictionless), rows of a gap operator g = g0 + G u >= 0:
 * cam - IR bore: node-to-rigid-curve, gap and normal re-evaluated at the deformed
   configuration and re-linearised until the geometry update is below 1e-6 mm;
-* balls: discrete elements between raceway patches (radial), initial gap G_r / 2, and a
-  Hertz law delta = c P^(2/3) (exact elliptic-contact Hertz, both raceways in series)
+* balls: discrete elements between raceway arcs (radial; each row is the exact P1 mean of
+  u_r over an arc of +-ball_dia/8, fixed in mm so the patch does not depend on the mesh),
+  initial gap G_r / 2, and a Hertz law delta = c P^(2/3) (exact elliptic-contact Hertz, both raceways in series)
   added as a secant compliance to the diagonal; secant updated to convergence;
 * OR outer - FS bore: mortar-type bins (piecewise-constant pressure over 1 deg arcs;
-  average radial displacement of each side), initial gap (D_nom - D)/2 from the fit;
+  exact P1 mean of u_r of each side over the arc), initial gap (D_nom - D)/2 from the fit.
+  Both arc rows integrate the field along the boundary edges instead of averaging the
+  nodes that fall inside: node-count averages made the WG stiffness, and so Phi of HD 42,
+  jump by up to 4 % from one mesh to the next;
 * FS - CS flanks: node-to-segment (FS flank/tip nodes against CS boundary segments),
   built at the wave-generator-deflected configuration (gaps evaluated at the deformed FS)
   and linearised about it (small deformation on top of the deflected state).  At +-T
@@ -80,8 +84,8 @@ rim below the tooth roots (w_i = nodal areas), the 2D stand-in for the shear flo
 brings in; the twist is the work-conjugate mean rotation q^T u of the same region (exact
 rigid rotation for a rigid motion).  Curve twists are relative to the first (+0) state.
 
-Approximations (known, small): P1 triangles (Phi moves by about +-0.5 % between 0.75x and
-1.5x the paper's density; the elastic part phi by about +-4 %); the fit bins compare the
+Approximations (known, small): P1 triangles (Phi of the designs we checked moves by
+< 2 % between 1x and 1.25x the paper's density, see docs/fe-model.md); the fit bins compare the
 two surfaces at equal reference angles (their relative slide of ~10 um on a surface slope
 <= 0.017 shifts those gaps by < 0.2 um, the same for every design); ball 0 sits on the
 major axis (one sample of the WG angle); no friction, no cup torsion (see background).
@@ -108,6 +112,7 @@ from .mesh import BodyMesh, DriveMesh
 TOL_GAP = 1e-5          # mm: 0.01 um allowed penetration
 ZERO_TORQUE_BIAS = 1e-3  # fraction of the test torque used at the zero-torque steps
 RELIN_TOL = 5e-5         # mm: re-linearise tooth pairs at +-T above 0.05 um re-detected
+BALL_PATCH_FRAC = 0.125  # ball load spread over +-ball_dia/8 of raceway arc
 RELIN_NEAR = 5e-3        # mm: ... but only those pairs closer than this (the loaded flanks)
 
 
@@ -345,6 +350,49 @@ def _radial_rows(body: _Body, nodes_per_row: list[np.ndarray], sign: float, nwat
             v.append(w * cs)
     return sp.csr_matrix((np.concatenate(v), (np.concatenate(r), np.concatenate(c))),
                          shape=(len(nodes_per_row), nwatch))
+
+
+def _arc_average_rows(body: _Body, edges: np.ndarray, centres: np.ndarray, half_width: float,
+                      sign: float, per: float, nwatch: int) -> sp.csr_matrix:
+    """Rows giving sign * the mean radial displacement over the arcs
+    [centre - half_width, centre + half_width] of a circular boundary (mortar-type).
+
+    The P1 field is integrated exactly along the boundary edges (in angle), so a row
+    does not depend on which nodes happen to fall inside its arc: the mesh only changes
+    the quadrature, not the definition.  ``per`` is the period in angle (pi in the half
+    model: an arc reaching below 0 uses the edges near pi, whose radial motion is that of
+    their images)."""
+    p = body.x
+    th = np.arctan2(p[1], p[0])
+    n1, n2 = edges[:, 0], edges[:, 1]
+    dt = np.angle(np.exp(1j * (th[n2] - th[n1])))          # signed edge span
+    r, c, v = [], [], []
+    for i, cen in enumerate(centres):
+        # edge end angles relative to the centre, wrapped into (-per/2, per/2]
+        a1 = (th[n1] - cen + per / 2) % per - per / 2
+        a2 = a1 + dt
+        lo, hi = np.minimum(a1, a2), np.maximum(a1, a2)
+        s_lo, s_hi = np.maximum(lo, -half_width), np.minimum(hi, half_width)
+        on = s_hi > s_lo
+        if not on.any():
+            raise ValueError(f"{body.name}: no boundary edge within the arc at "
+                             f"{math.degrees(cen):.2f} deg")
+        L = (hi - lo)[on]
+        # integral of the hat functions of the edge's two nodes over the overlap
+        t_lo, t_hi = s_lo[on], s_hi[on]
+        first_is_lo = (a1 <= a2)[on]
+        w_at_hi = (0.5 * (t_hi ** 2 - t_lo ** 2) - lo[on] * (t_hi - t_lo)) / L
+        w_at_lo = (t_hi - t_lo) - w_at_hi
+        w1 = np.where(first_is_lo, w_at_lo, w_at_hi)
+        w2 = np.where(first_is_lo, w_at_hi, w_at_lo)
+        nodes = np.concatenate([n1[on], n2[on]])
+        w = sign * np.concatenate([w1, w2]) / (2 * half_width)
+        for comp, trig in ((0, np.cos(th[nodes])), (1, np.sin(th[nodes]))):
+            r.append(np.full(nodes.size, i))
+            c.append(body.wpos[comp, nodes])
+            v.append(w * trig)
+    return sp.csr_matrix((np.concatenate(v), (np.concatenate(r), np.concatenate(c))),
+                         shape=(len(centres), nwatch))
 
 
 def _boundary_edge_normals(mesh, edges: np.ndarray) -> np.ndarray:
@@ -586,40 +634,29 @@ class LostMotionModel:
     def ball_rows(self) -> _Rows:
         g = self.g
         ir, orr = self.bodies["ir"], self.bodies["or"]
-        # half model: the balls in [0, pi) (ball 0 on the cut, its image at pi implied);
-        # a patch reaching below angle 0 takes the images near pi (same radial motion)
+        # half model: the balls in [0, pi) (ball 0 on the cut, its image at pi implied)
         nb = g.n_balls // 2 if self.half else g.n_balls
         per = math.pi if self.half else 2 * math.pi
         thb = 2 * math.pi * np.arange(nb) / g.n_balls
-        def patches(b, nodes):
-            nodes = self._indep(b, nodes)
-            th = np.arctan2(b.x[1, nodes], b.x[0, nodes])
-            h = per / nodes.size
-            out = []
-            for t in thb:
-                d = np.abs(np.angle(np.exp(2j * math.pi / per * (th - t)))) * per / (2 * math.pi)
-                out.append(nodes[d <= 1.01 * h])
-            return out
-        Gi = _radial_rows(ir, patches(ir, ir.bm.node_sets["ir_race"]), -1.0, self.nwatch)
-        Go = _radial_rows(orr, patches(orr, orr.bm.node_sets["or_race"]), +1.0, self.nwatch)
+        # each ball acts on a raceway arc of a quarter ball diameter, fixed in mm so the
+        # patch stiffness does not depend on the mesh (the Hertz law adds the local part)
+        hw_i = BALL_PATCH_FRAC * g.ball_dia / g.ir_race
+        hw_o = BALL_PATCH_FRAC * g.ball_dia / g.or_race
+        Gi = _arc_average_rows(ir, ir.bm.edge_sets["ir_race"], thb, hw_i, -1.0, per, self.nwatch)
+        Go = _arc_average_rows(orr, orr.bm.edge_sets["or_race"], thb, hw_o, +1.0, per, self.nwatch)
         return _Rows("ball", (Gi + Go).tocsr(), np.full(nb, g.ball_gap))
 
     def fit_rows(self) -> _Rows:
         g = self.g
         fs, orr = self.bodies["fs"], self.bodies["or"]
-        # half model: the bins over [0, pi) only, nodes taken modulo pi (same bin width)
+        # half model: the bins over [0, pi) only (same bin width)
         nbin = self.n_bins // 2 if self.half else self.n_bins
         per = math.pi if self.half else 2 * math.pi
-        def bins(b, nodes):
-            nodes = self._indep(b, nodes)
-            th = np.mod(np.arctan2(b.x[1, nodes], b.x[0, nodes]), per)
-            k = np.floor(th / per * nbin + 0.5).astype(int) % nbin
-            return [nodes[k == i] for i in range(nbin)]
-        bf, bo = bins(fs, fs.bm.node_sets["fs_bore"]), bins(orr, orr.bm.node_sets["or_outer"])
-        if any(len(x) == 0 for x in bf + bo):
-            raise ValueError("mortar bins without nodes: mesh too coarse for n_bins")
-        G = (_radial_rows(fs, bf, +1.0, self.nwatch)
-             + _radial_rows(orr, bo, -1.0, self.nwatch)).tocsr()
+        centres = per * np.arange(nbin) / nbin
+        hw = math.pi / self.n_bins
+        G = (_arc_average_rows(fs, fs.bm.edge_sets["fs_bore"], centres, hw, +1.0, per, self.nwatch)
+             + _arc_average_rows(orr, orr.bm.edge_sets["or_outer"], centres, hw, -1.0, per,
+                                 self.nwatch)).tocsr()
         return _Rows("fit", G, np.full(nbin, g.r_fs_bore - g.or_outer))
 
     def tooth_rows(self, u_watch: np.ndarray, cand_gap: float,
