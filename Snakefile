@@ -20,6 +20,7 @@ include: "workflow/rules/doe.smk"
 include: "workflow/rules/paper.smk"
 include: "workflow/rules/fe.smk"
 include: "workflow/rules/stats.smk"
+include: "workflow/rules/validation.smk"
 include: "workflow/rules/report.smk"
 
 

@@ -67,6 +67,8 @@ def _check_relations(config: dict, source) -> None:
         if study["source"] == "paper" and study.get("designs", "paper") != "paper":
             raise ConfigError(source, "a paper study uses the paper's designs", field=f"studies.{name}.designs",
                               value=study["designs"])
+    for name, camp in config.get("validation", {}).items():
+        _check_campaign(name, camp, source)
     sob = config.get("sobol", {})
     n_start = sob.get("n_start")
     if n_start is not None and n_start & (n_start - 1):
@@ -75,6 +77,39 @@ def _check_relations(config: dict, source) -> None:
     if n_start is not None and not n_start <= sob["n_min"] <= sob["n_max"]:
         raise ConfigError(source, f"need n_start <= n_min <= n_max, got {n_start}, {sob['n_min']}, {sob['n_max']}",
                           field="sobol.n_min", value=sob["n_min"])
+
+
+def _check_campaign(name: str, camp: dict, source) -> None:
+    """Effect names, parameters and values of a campaign against the effects registry."""
+    from .effects import registry
+
+    known = registry()
+    where = f"validation.{name}"
+    for eff, params in camp.get("effects", {}).items():
+        if eff not in known:
+            raise ConfigError(source, f"unknown effect; known: {', '.join(known)}", field=f"{where}.effects",
+                              value=eff)
+        names = {p.name for p in known[eff].parameters}
+        for pname, value in params.items():
+            key = f"{where}.effects.{eff}.{pname}"
+            if pname not in names:
+                raise ConfigError(source, f"unknown parameter of {eff}; it has {', '.join(sorted(names))}",
+                                  field=key, value=pname)
+            if value != "calibrate":
+                try:
+                    known[eff].param(pname).check(value, key)
+                except ValueError as exc:
+                    raise ConfigError(source, str(exc).split(": ", 1)[-1], field=key, value=value) from None
+        missing = names - set(params)
+        if missing:
+            raise ConfigError(source, f"give every parameter of {eff} (missing {', '.join(sorted(missing))})",
+                              field=f"{where}.effects.{eff}")
+    cands = camp.get("candidates", "all")
+    if cands != "all":
+        for c in cands:
+            if c not in known:
+                raise ConfigError(source, f"unknown effect; known: {', '.join(known)}", field=f"{where}.candidates",
+                                  value=c)
 
 
 def load_config(path: str | Path, schema_path: str | Path) -> dict:

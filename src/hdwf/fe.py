@@ -113,7 +113,41 @@ TOL_GAP = 1e-5          # mm: 0.01 um allowed penetration
 ZERO_TORQUE_BIAS = 1e-3  # fraction of the test torque used at the zero-torque steps
 RELIN_TOL = 5e-5         # mm: re-linearise tooth pairs at +-T above 0.05 um re-detected
 BALL_PATCH_FRAC = 0.125  # ball load spread over +-ball_dia/8 of raceway arc
+FRICTION_MAX_IT = 30     # slip-direction iterations per load level (flank friction)
+SLIP_TOL = 1e-7          # mm: a slip below 0.1 nm over a step counts as none
 RELIN_NEAR = 5e-3        # mm: ... but only those pairs closer than this (the loaded flanks)
+
+
+@dataclass(frozen=True)
+class ModelChanges:
+    """Physical additions to the baseline model (frictionless flanks, CS clamped on its
+    whole outer rim, FS and CS at one temperature, output read on the FS rim).
+
+    ``hdwf.effects`` maps each candidate effect's parameters onto these; every field is a
+    change to the FE model itself:
+
+    * ``flank_friction``: Coulomb coefficient on the FS-CS tooth contacts.  Each contact
+      force becomes p (n + mu sigma t), sigma = -sign of the flank slip over the load
+      step (sliding), or the value in [-1, 1] that makes the slip vanish (sticking).
+    * ``cs_rim_stiffness_N_mm2``: the CS outer rim held by radial and tangential springs
+      of this stiffness per mm of rim (an elastic housing) instead of clamped (inf).
+    * ``cs_scale``: the CS mesh scaled about the axis by this factor, i.e. a uniform
+      thermal strain of the CS relative to the FS and wave generator (1 = same
+      temperature; plane-stress stiffness is scale-invariant, only the fit changes).
+    * ``output_compliance_rad_per_Nmm``: a torsional spring in series between the FS rim
+      and the output where the twist is measured (the FS cup and diaphragm).
+    * ``output_play_rad``: a dead band in series in the output chain (e.g. the wave
+      generator's Oldham coupling, seen at the output).
+    """
+    flank_friction: float = 0.0
+    cs_rim_stiffness_N_mm2: float = math.inf
+    cs_scale: float = 1.0
+    output_compliance_rad_per_Nmm: float = 0.0
+    output_play_rad: float = 0.0
+
+    def fe_part(self) -> "ModelChanges":
+        """The changes that need a new contact solve (the series elements do not)."""
+        return ModelChanges(self.flank_friction, self.cs_rim_stiffness_N_mm2, self.cs_scale)
 
 
 # --------------------------------------------------------------------------------------
@@ -275,9 +309,17 @@ def _symmetry_map(p: np.ndarray, nd: np.ndarray):
 
 
 def _make_body(name: str, bm: BodyMesh, E: float, nu: float, fixed_nodes=None,
-               watch_nodes=None, half: bool = False) -> tuple[_Body, float]:
+               watch_nodes=None, half: bool = False,
+               ground_springs: np.ndarray | None = None) -> tuple[_Body, float]:
+    """``ground_springs`` (N/mm per node, both directions) hold the body elastically:
+    then nothing is pinned and the body has no rigid modes."""
     K, basis = assemble_stiffness(bm, E, nu)
     nd = basis.nodal_dofs
+    if ground_springs is not None:
+        kd = np.zeros(K.shape[0])
+        kd[nd[0]] = ground_springs
+        kd[nd[1]] = ground_springs
+        K = (K + sp.diags(kd)).tocsr()
     p = bm.mesh.p
     ndof = K.shape[0]
     modes = {}
@@ -287,7 +329,9 @@ def _make_body(name: str, bm: BodyMesh, E: float, nu: float, fixed_nodes=None,
         P, dep = _symmetry_map(p, nd)
         Kr = (P.T @ K @ P).tocsr()
         red = P.indices                      # reduced dof of every body dof (one entry a row)
-    if fixed_nodes is not None:
+    if ground_springs is not None:
+        fixed = np.zeros(0, dtype=np.int64)
+    elif fixed_nodes is not None:
         fixed = np.concatenate([nd[0, fixed_nodes], nd[1, fixed_nodes]])
         if half:
             fixed = np.unique(red[fixed])
@@ -395,6 +439,16 @@ def _arc_average_rows(body: _Body, edges: np.ndarray, centres: np.ndarray, half_
                          shape=(len(centres), nwatch))
 
 
+def _boundary_lengths(mesh, edges: np.ndarray) -> np.ndarray:
+    """Tributary boundary length (mm) of every node of ``mesh`` (zero off ``edges``)."""
+    p = mesh.p
+    L = np.hypot(*(p[:, edges[:, 1]] - p[:, edges[:, 0]]))
+    w = np.zeros(p.shape[1])
+    np.add.at(w, edges[:, 0], L / 2)
+    np.add.at(w, edges[:, 1], L / 2)
+    return w
+
+
 def _boundary_edge_normals(mesh, edges: np.ndarray) -> np.ndarray:
     """Unit normals of boundary edges pointing OUT of the body's material."""
     p = mesh.p
@@ -461,8 +515,10 @@ class LostMotionModel:
 
     def __init__(self, geom: DriveGeometry, mesh: DriveMesh, E: float | None = None,
                  max_iter: int = 200, tol_gap: float = TOL_GAP, zone_deg: float = 35.0,
-                 n_bins: int = 360):
+                 n_bins: int = 360, changes: ModelChanges | None = None):
         self.g = geom
+        self.changes = changes = ModelChanges() if changes is None else changes
+        self.mu = float(changes.flank_friction)
         self.E = geom.E if E is None else E
         self.max_iter, self.tol_gap = max_iter, tol_gap
         self.iterations = 0
@@ -474,7 +530,14 @@ class LostMotionModel:
         # half model: the half rim carries half the torque; the twist measure (mean rotation
         # of the rim) is the same for the half and the whole
         self.f_scale = 0.5 if self.half else 1.0
-        bms = mesh.bodies
+        bms = dict(mesh.bodies)
+        if changes.cs_scale != 1.0:     # thermal strain of the CS relative to the rest
+            cs0 = bms["cs"]
+            from skfem import MeshTri
+            bms["cs"] = BodyMesh(name=cs0.name, mesh=MeshTri(cs0.mesh.p * changes.cs_scale,
+                                                              cs0.mesh.t),
+                                 thickness=cs0.thickness, node_sets=cs0.node_sets,
+                                 edge_sets=cs0.edge_sets)
         # watch sets: every contact node (teeth only in the engagement zones)
         def zone(bm, nodes):
             th = np.arctan2(bm.mesh.p[1, nodes], bm.mesh.p[0, nodes])
@@ -487,10 +550,16 @@ class LostMotionModel:
         or_w = np.concatenate([bms["or"].node_sets["or_race"], bms["or"].node_sets["or_outer"]])
         self.factorize_s = 0.0
         self.bodies: dict[str, _Body] = {}
+        cs_springs = None
+        if math.isfinite(changes.cs_rim_stiffness_N_mm2):
+            cs_springs = changes.cs_rim_stiffness_N_mm2 * _boundary_lengths(
+                bms["cs"].mesh, bms["cs"].edge_sets["cs_outer"])
         for name, w, fixed in (("fs", fs_w, None),
                                ("cs", cs_w, bms["cs"].node_sets["cs_outer"]),
                                ("ir", ir_w, None), ("or", or_w, None)):
-            b, tf = _make_body(name, bms[name], self.E, geom.nu, fixed, w, self.half)
+            springs = cs_springs if name == "cs" else None
+            b, tf = _make_body(name, bms[name], self.E, geom.nu, fixed, w, self.half,
+                               ground_springs=springs)
             self.factorize_s += tf
             self.bodies[name] = b
         ofs = 0
@@ -531,6 +600,13 @@ class LostMotionModel:
         self.CW = np.zeros((0, 0))             # their compliance matrix
         self.W: list[tuple[str, int]] = []     # working-set pairs (kind, row index)
         self.Wpos: dict[tuple[str, int], int] = {}
+        # flank friction: K^-1 Gt^T columns (slip rows) and G_W K^-1 Gt_W^T
+        self._Ybuf = np.zeros((self.nwatch, 0))
+        self.Yq = np.zeros(0)
+        self.CWY = np.zeros((0, 0))
+        self.CWYY = np.zeros((0, 0))                     # Gt_W K^-1 Gt_W^T
+        self._TW = None
+        self._sigma: dict[tuple[str, int], float] = {}   # friction direction per pair
 
     # ---------------------------------------------------------------- linear algebra
     def _solve_body(self, b: _Body, F: np.ndarray) -> np.ndarray:
@@ -699,19 +775,26 @@ class LostMotionModel:
         sn, bg, be, bt = sn[keep], bg[keep], be[keep], bt[keep]
         n = nrm[:, be]
         k = sn.size
-        rows, cols, vals = [], [], []
-        for comp in (0, 1):
-            rows += [np.arange(k)] * 3
-            cols += [fs.wpos[comp, sn], cs.wpos[comp, E[be, 0]], cs.wpos[comp, E[be, 1]]]
-            vals += [n[comp], -(1 - bt) * n[comp], -bt * n[comp]]
-        G = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                          shape=(k, self.nwatch))
+
+        def pair_rows(d):
+            """Rows d . (u_FS node - u_CS point) for a direction d per pair."""
+            rows, cols, vals = [], [], []
+            for comp in (0, 1):
+                rows += [np.arange(k)] * 3
+                cols += [fs.wpos[comp, sn], cs.wpos[comp, E[be, 0]], cs.wpos[comp, E[be, 1]]]
+                vals += [d[comp], -(1 - bt) * d[comp], -bt * d[comp]]
+            return sp.csr_matrix((np.concatenate(vals),
+                                  (np.concatenate(rows), np.concatenate(cols))),
+                                 shape=(k, self.nwatch))
+
+        G = pair_rows(n)
+        Gt = pair_rows(np.vstack([-n[1], n[0]]))   # slip along the CS flank (friction)
         g0 = bg - G @ u_watch
         th = np.arctan2(fs.x[1, sn], fs.x[0, sn])
         # half model: tooth z/2 is the image of tooth 0 (ids modulo z/2; count them twice)
         zid = self.g.z_fs // 2 if self.half else self.g.z_fs
         tooth = np.round(th / (2 * math.pi / self.g.z_fs)).astype(int) % zid
-        return _Rows("tooth", G, g0, {"tooth": tooth, "nodes": sn})
+        return _Rows("tooth", G, g0, {"tooth": tooth, "nodes": sn, "Gt": Gt})
 
     @staticmethod
     def _indep(b: _Body, nodes: np.ndarray) -> np.ndarray:
@@ -728,6 +811,28 @@ class LostMotionModel:
         ids = [(k, i) for k in kinds for i in range(self.rows[k].G.shape[0])]
         return G, g0, ids
 
+    def _slip_rows(self, ids) -> sp.csr_matrix:
+        """Slip rows (tangent to the CS flank) of the pairs ``ids``; zero for non-teeth."""
+        out = []
+        for k, i in ids:
+            gt = self.rows[k].info.get("Gt")
+            out.append(gt[i] if gt is not None else sp.csr_matrix((1, self.nwatch)))
+        return sp.vstack(out).tocsr() if out else sp.csr_matrix((0, self.nwatch))
+
+    def _all_slip_rows(self) -> sp.csr_matrix:
+        return sp.vstack([self.rows[k].info["Gt"] if "Gt" in self.rows[k].info
+                          else sp.csr_matrix((self.rows[k].G.shape[0], self.nwatch))
+                          for k in self.rows]).tocsr()
+
+    @staticmethod
+    def _grow(buf: np.ndarray, n0: int, k: int) -> np.ndarray:
+        if n0 + k <= buf.shape[1]:
+            return buf
+        cap = max(2 * buf.shape[1], n0 + k, 256)     # grow the column store geometrically
+        new = np.zeros((buf.shape[0], cap))
+        new[:, :n0] = buf[:, :n0]
+        return new
+
     def _add_to_W(self, ids: list[tuple[str, int]]):
         ids = [i for i in ids if i not in self.Wpos]
         if not ids:
@@ -735,11 +840,7 @@ class LostMotionModel:
         Gn = sp.vstack([self.rows[k].G[i] for k, i in ids]).tocsr()
         X, Xq = self._columns(Gn)
         n0, k = len(self.W), len(ids)
-        if n0 + k > self._Xbuf.shape[1]:        # grow the column store geometrically
-            cap = max(2 * self._Xbuf.shape[1], n0 + k, 256)
-            buf = np.zeros((self.nwatch, cap))
-            buf[:, :n0] = self._Xbuf[:, :n0]
-            self._Xbuf = buf
+        self._Xbuf = self._grow(self._Xbuf, n0, k)
         self._Xbuf[:, n0:n0 + k] = X
         for i in ids:
             self.Wpos[i] = len(self.W)
@@ -753,6 +854,27 @@ class LostMotionModel:
         CW[:, n0:] = newcols
         CW[n0:, :n0] = newcols[:n0].T
         self.CW = CW
+        if self.mu > 0:                    # columns of the slip rows (not symmetric)
+            Tn = self._slip_rows(ids)
+            Y, Yq = self._columns(Tn)
+            self._Ybuf = self._grow(self._Ybuf, n0, k)
+            self._Ybuf[:, n0:n0 + k] = Y
+            self.Yq = np.concatenate([self.Yq, Yq])
+            self._TW = Tn if self._TW is None else sp.vstack([self._TW, Tn]).tocsr()
+            CWY = np.zeros((n0 + k, n0 + k))
+            CWY[:n0, :n0] = self.CWY
+            CWY[:, n0:] = np.asarray(self._GW @ Y)
+            CWY[n0:, :n0] = np.asarray(Gn @ self._Ybuf[:, :n0])
+            self.CWY = CWY
+            CWYY = np.zeros((n0 + k, n0 + k))
+            CWYY[:n0, :n0] = self.CWYY
+            CWYY[:, n0:] = np.asarray(self._TW @ Y)
+            CWYY[n0:, :n0] = np.asarray(Tn @ self._Ybuf[:, :n0])
+            self.CWYY = CWYY
+
+    @property
+    def Yw(self) -> np.ndarray:
+        return self._Ybuf[:, :len(self.W)]
 
     @property
     def Xw(self) -> np.ndarray:
@@ -769,13 +891,23 @@ class LostMotionModel:
             self.Xq[pos] = Xq
             self._GW = sp.vstack([self.rows[k].G[i] for k, i in self.W]).tocsr()
             self.CW = np.asarray(self._GW @ self.Xw)
+            if self.mu > 0:
+                Y, Yq = self._columns(self._slip_rows([(kind, b) for _, b in idx]))
+                self._Ybuf[:, pos] = Y
+                self.Yq[pos] = Yq
+                self.CWY = np.asarray(self._GW @ self.Yw)
+                self._TW = self._slip_rows(self.W)
+                self.CWYY = np.asarray(self._TW @ self.Yw)
 
     # ---------------------------------------------------------------- full fields
     def full_displacements(self, st: dict, T: float) -> dict[str, np.ndarray]:
         """Displacement (2, nnodes) of every body at a solved level, u = K^-1 (f + G^T p) + R alpha
         (the same superposition the twist is read from); one back-substitution per body."""
         G, _, _ = self._all_rows()
-        force_watch = sp.csc_matrix((G.T @ st["p"])[:, None])
+        forces = G.T @ st["p"]
+        if self.mu > 0:                  # friction: the forces lean along the flank
+            forces = forces + self._all_slip_rows().T @ st["ft"]
+        force_watch = sp.csc_matrix(forces[:, None])
         out = {}
         for name, b in self.bodies.items():
             F = self._watch_to_body(name, force_watch)
@@ -791,7 +923,12 @@ class LostMotionModel:
     # ---------------------------------------------------------------- one load level
     def solve_level(self, T: float, active: dict | None):
         """Solve the contact problem at torque T (N mm), warm-started from ``active``
-        (and the last displacement); Hertz secants of the balls iterated to 0.1 %."""
+        (and the last displacement); Hertz secants of the balls iterated to 0.1 %.
+
+        With flank friction the slip direction of every tooth pair over this load step is
+        iterated too: sigma = -sign(slip) for sliding pairs; a pair whose slip changes
+        sign with sigma is sticking, and its sigma in [-1, 1] is found by the secant rule
+        on slip = 0 (the tangential force inside the friction cone)."""
         G, g0, ids = self._all_rows()
         R, Rq, Rf = self._R()
         GR = G @ R
@@ -803,13 +940,60 @@ class LostMotionModel:
         u0 = T * self.uq_watch if base is None else base
         gfree = g0 + G @ u0
         act |= {ids[j] for j in np.flatnonzero(gfree < -self.tol_gap)}
+        fr = None
+        if self.mu > 0:
+            # friction state of every tooth pair: +-1 sliding (tangential force mu p sigma),
+            # 0 sticking (tangential force unknown, slip over the step = 0), nan not yet
+            # in contact (no tangential force until its slip is known)
+            Gt = self._all_slip_rows()
+            tooth = np.array([k == "tooth" for k, _ in ids])
+            state = np.array([self._sigma.get(i, np.nan) for i in ids])
+            fr = dict(Gt=Gt, TR=Gt @ R, s_target=Gt @ u0, state=state)
+        for fric_it in range(FRICTION_MAX_IT):
+            p_full, ft, alpha, u, gap, act = self._hertz_loop(T, G, g0, ids, idpos, R, Rq, Rf,
+                                                              GR, act, ball_idx, fr)
+            if fr is None:
+                break
+            state = fr["state"]
+            slip = fr["Gt"] @ u - fr["s_target"]
+            loaded = tooth & (p_full > 0)
+            new = state.copy()
+            new[~loaded] = np.nan
+            # a pair coming into contact slides against its slip
+            fresh = loaded & np.isnan(state)
+            new[fresh] = np.where(np.abs(slip[fresh]) < SLIP_TOL, 0.0, -np.sign(slip[fresh]))
+            # sticking pair beyond the cone: slides in the direction of its force
+            over = loaded & (state == 0) & (np.abs(ft) > self.mu * p_full * (1 + 1e-9))
+            new[over] = np.sign(ft[over])
+            # sliding pair whose slip runs with its friction force: it sticks
+            back = loaded & (state != 0) & (state * slip > SLIP_TOL)
+            new[back] = 0.0
+            if np.array_equal(new, state, equal_nan=True):
+                break
+            fr["state"] = new
+        else:
+            raise ContactFailure("flank friction: stick/slip states did not settle in "
+                                 f"{FRICTION_MAX_IT} iterations at T={T / 1000:.4g} N m")
+        if fr is not None:
+            self._sigma = {ids[j]: float(fr["state"][j]) for j in np.flatnonzero(tooth)}
+        self._u_last = u
+        wp = np.array([self.Wpos[i] for i in ids if i in self.Wpos], dtype=np.int64)
+        pw = np.array([p_full[idpos[i]] for i in ids if i in self.Wpos])
+        twist = T * self.qq + (self.Xq[wp] @ pw if wp.size else 0.0) + Rq @ alpha
+        if fr is not None and wp.size:
+            fw = np.array([ft[idpos[i]] for i in ids if i in self.Wpos])
+            twist += self.Yq[wp] @ fw
+        return dict(p=p_full, alpha=alpha, u=u, gap=gap, ids=ids, twist=float(twist),
+                    active={i: True for i in act}, ft=ft)
+
+    def _hertz_loop(self, T, G, g0, ids, idpos, R, Rq, Rf, GR, act, ball_idx, fr):
         pb = getattr(self, "_ball_p", None)
         if pb is None:
             pb = np.full(self.rows["ball"].G.shape[0], 1.0)
         for hertz_it in range(40):
             s_ball = self.ball_c * np.maximum(pb, 1e-3) ** (-1.0 / 3.0)
-            p_full, alpha, u, gap, conv = self._pdas(T, G, g0, ids, idpos, R, Rq, Rf, GR,
-                                                     act, s_ball, ball_idx)
+            p_full, ft, alpha, u, gap, conv = self._pdas(T, G, g0, ids, idpos, R, Rq, Rf, GR,
+                                                         act, s_ball, ball_idx, fr)
             act = {ids[j] for j in np.flatnonzero(p_full > 0)}
             pb_new = p_full[ball_idx]
             on = pb_new > 0        # the secant of an open ball does not matter
@@ -824,20 +1008,17 @@ class LostMotionModel:
         else:
             raise ContactFailure("Hertz secant iteration on ball loads did not converge")
         self._ball_p = pb
-        self._u_last = u
-        wp = np.array([self.Wpos[i] for i in ids if i in self.Wpos], dtype=np.int64)
-        pw = np.array([p_full[idpos[i]] for i in ids if i in self.Wpos])
-        twist = T * self.qq + (self.Xq[wp] @ pw if wp.size else 0.0) + Rq @ alpha
-        return dict(p=p_full, alpha=alpha, u=u, gap=gap, ids=ids, twist=float(twist),
-                    active={i: True for i in act})
+        return p_full, ft, alpha, u, gap, act
 
-    def _pdas(self, T, G, g0, ids, idpos, R, Rq, Rf, GR, act, s_ball, ball_idx):
+    def _pdas(self, T, G, g0, ids, idpos, R, Rq, Rf, GR, act, s_ball, ball_idx, fr=None):
         """Primal-dual active set on the dense dual problem; see the module docstring."""
         nm = R.shape[1]
         npairs = len(ids)
         sdiag = np.zeros(npairs)
         sdiag[ball_idx] = s_ball
         Guq = G @ self.uq_watch
+        friction = fr is not None
+        ft_full = np.zeros(npairs)
         A = set(act)
         for it in range(self.max_iter):
             self.iterations += 1
@@ -871,20 +1052,52 @@ class LostMotionModel:
             C = 0.5 * (C + C.T) + np.diag(sdiag[rows])
             H = GR[rows]
             scale = np.abs(np.diag(C)).max() if nA else 1.0
-            M = np.zeros((nA + nm, nA + nm))
-            M[:nA, :nA] = C + 1e-13 * scale * np.eye(nA)
-            M[:nA, nA:] = H
-            M[nA:, :nA] = H.T
-            M[nA:, nA:] = -1e-14 * np.eye(nm)     # keeps unheld, unloaded modes at zero
-            rhs = np.concatenate([-(g0[rows] + T * Guq[rows]), -T * Rf])
+            if not friction:
+                nS = 0
+                M = np.zeros((nA + nm, nA + nm))
+                M[:nA, :nA] = C + 1e-13 * scale * np.eye(nA)
+                M[:nA, nA:] = H
+                M[nA:, :nA] = H.T
+                rhs = np.concatenate([-(g0[rows] + T * Guq[rows]), -T * Rf])
+            else:
+                # unknowns (p_A, lambda_S, alpha): sliding pairs add mu sigma p along the
+                # flank, sticking pairs S an unknown tangential force with zero slip
+                st = fr["state"][rows]
+                ms = self.mu * np.nan_to_num(st)
+                sk = np.flatnonzero(st == 0)
+                Swp, Srows, nS = wp[sk], rows[sk], sk.size
+                TR = fr["TR"]
+                n = nA + nS
+                M = np.zeros((n + nm, n + nm))
+                M[:nA, :nA] = C + self.CWY[np.ix_(wp, wp)] * ms[None, :] + 1e-13 * scale * np.eye(nA)
+                M[:nA, nA:n] = self.CWY[np.ix_(wp, Swp)]
+                M[:nA, n:] = H
+                M[nA:n, :nA] = self.CWY[np.ix_(wp, Swp)].T + self.CWYY[np.ix_(Swp, wp)] * ms[None, :]
+                M[nA:n, nA:n] = self.CWYY[np.ix_(Swp, Swp)] + 1e-13 * scale * np.eye(nS)
+                M[nA:n, n:] = TR[Srows]
+                M[n:, :nA] = (H + ms[:, None] * TR[rows]).T
+                M[n:, nA:n] = TR[Srows].T
+                Gt = fr["Gt"]
+                rhs = np.concatenate([-(g0[rows] + T * Guq[rows]),
+                                      fr["s_target"][Srows] - T * (Gt[Srows] @ self.uq_watch),
+                                      -T * Rf])
+            M[nA + nS:, nA + nS:] = -1e-14 * np.eye(nm)   # keeps unheld, unloaded modes at zero
             try:
                 sol = np.linalg.solve(M, rhs)
             except np.linalg.LinAlgError:
                 sol = np.linalg.lstsq(M, rhs, rcond=None)[0]
-            pA, alpha = sol[:nA], sol[nA:]
+            pA, alpha = sol[:nA], sol[nA + nS:]
             pW = np.zeros(len(self.W))
             pW[wp] = pA
             u = T * self.uq_watch + self.Xw @ pW + R @ alpha
+            if friction:
+                ftA = ms * pA
+                ftA[sk] = sol[nA:nA + nS]
+                fW = np.zeros(len(self.W))
+                fW[wp] = ftA
+                u = u + self.Yw @ fW
+                ft_full = np.zeros(npairs)
+                ft_full[rows] = ftA
             p_full = np.zeros(npairs)
             p_full[rows] = pA
             gap = g0 + G @ u + sdiag * p_full
@@ -901,17 +1114,34 @@ class LostMotionModel:
                       f"ming {gap.min():.3g} alpha {np.round(alpha, 6)}")
             if not neg and not viol:
                 p_full = np.maximum(p_full, 0.0)
-                return p_full, alpha, u, gap, True
+                return p_full, ft_full, alpha, u, gap, True
             if it > 25 and neg:          # anti-cycling: one change at a time
                 neg = [Al[int(np.argmin(pA))]]
             A.difference_update(neg)
             A.update(viol)
-        return p_full, alpha, u, gap, False
+        return p_full, ft_full, alpha, u, gap, False
 
 
 # --------------------------------------------------------------------------------------
 # Public driver
 # --------------------------------------------------------------------------------------
+def series_output_twist(rim_twist_rad: np.ndarray, torque_Nmm: np.ndarray,
+                        changes: ModelChanges) -> np.ndarray:
+    """Twist at the output (rad) from the twist of the FS rim along the test sequence:
+    the series spring adds T c, the dead band +-play/2 in the direction of the last
+    non-zero load (the zero-torque steps keep the side they were loaded from)."""
+    out = np.asarray(rim_twist_rad, dtype=float) + changes.output_compliance_rad_per_Nmm * \
+        np.asarray(torque_Nmm, dtype=float)
+    if changes.output_play_rad:
+        side, last = np.zeros(len(out)), 1.0
+        for k, T in enumerate(torque_Nmm):
+            if abs(T) > 0:
+                last = math.copysign(1.0, T)
+            side[k] = last
+        out = out + 0.5 * changes.output_play_rad * side
+    return out
+
+
 def _load_path(steps_per_ramp: int) -> np.ndarray:
     n = steps_per_ramp
     up = np.linspace(0, 1, n + 1)
@@ -920,14 +1150,17 @@ def _load_path(steps_per_ramp: int) -> np.ndarray:
 
 def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int = 5,
                       E: float | None = None, max_iter: int = 200,
-                      tol_gap: float = TOL_GAP, keep_fields: bool = False) -> LostMotionResult:
+                      tol_gap: float = TOL_GAP, keep_fields: bool = False,
+                      changes: ModelChanges | None = None) -> LostMotionResult:
     """Simulate the lost-motion test 0 -> +T -> 0 -> -T -> 0 (WG locked, CS fixed).
 
     ``E`` overrides Young's modulus (e.g. the rigid-body limit); ``max_iter`` limits the
     active-set iterations per load level (a run that hits it returns status "failed");
     ``keep_fields`` also returns the displacement of every node after the wave generator
-    is mounted (``wg``) and at +T (``plus``).
+    is mounted (``wg``) and at +T (``plus``); ``changes`` switches on physical additions
+    to the baseline model (``ModelChanges``, set by ``hdwf.effects``).
     """
+    changes = ModelChanges() if changes is None else changes
     t0 = time.perf_counter()
     frac = _load_path(steps_per_ramp)
     Tn = geom.torque
@@ -935,7 +1168,8 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
     empty = np.array([])
     model = None
     try:
-        model = LostMotionModel(geom, mesh, E=E, max_iter=max_iter, tol_gap=tol_gap)
+        model = LostMotionModel(geom, mesh, E=E, max_iter=max_iter, tol_gap=tol_gap,
+                                changes=changes)
         # ---- stage 1: wave generator (no teeth), FS rotation pinned
         # (the half model's symmetric field has no translations: no modes in stage 1)
         model.mode_list = [] if model.half else [("fs", "tx"), ("fs", "ty"), ("ir", "tx"),
@@ -992,8 +1226,9 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
                     near = (tr.g0 + tr.G @ st["u"]) < RELIN_NEAR
                     Dn = sp.diags(near.astype(float))
                     Df = sp.diags((~near).astype(float))
+                    info = dict(tr.info, Gt=(Dn @ new.info["Gt"] + Df @ tr.info["Gt"]).tocsr())
                     mixed = _Rows("tooth", (Dn @ new.G + Df @ tr.G).tocsr(),
-                                  np.where(near, new.g0, tr.g0), tr.info)
+                                  np.where(near, new.g0, tr.g0), info)
                     model._replace_rows("tooth", mixed)
                     st = model.solve_level(T, st["active"])
                 maxpen_nl = max(maxpen_nl, pen_nl)
@@ -1011,7 +1246,7 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
                 tooth_count = int(np.unique(tr.info["tooth"][np.array(ti)[pt > 0]]).size)
                 if model.half:
                     tooth_count *= 2             # every tooth has its image at +pi
-        tw = np.array(twists) / ARCMIN
+        tw = series_output_twist(np.array(twists), frac * Tn, changes) / ARCMIN
         tw = tw - tw[0]
         kp = int(np.argmin(np.abs(frac - 1.0)))
         km = int(np.argmin(np.abs(frac + 1.0)))

@@ -185,3 +185,70 @@ def deformed_figure(mesh, fields: dict, title: str, path, half_width_mm: float, 
     ax.set_ylabel("y (mm)")
     ax.set_title(title, fontsize=10)
     _save(fig, path)
+
+
+# ------------------------------------------------------------------ model against measurements
+
+def measured_vs_predicted_figure(points: pd.DataFrame, title: str, path) -> None:
+    """Measured against predicted, before (campaign model) and after (found effects on)."""
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), sharex=True, sharey=True)
+    D = points["D"].to_numpy(float)
+    lo, hi = np.nanmin(D), np.nanmax(D)
+    pad = 0.05 * (hi - lo or 1.0)
+    for ax, col, name in zip(axes, ("S_model", "S_final"), ("campaign model", "with the found effects")):
+        S = points[col].to_numpy(float)
+        rmse = float(np.sqrt(np.mean((S - D) ** 2)))
+        ax.plot([lo - pad, hi + pad], [lo - pad, hi + pad], "k-", lw=0.8)
+        ax.plot(S, D, "o", ms=3, alpha=0.6)
+        ax.set_title(f"{name}: RMSE {rmse:.4f} arcmin")
+        ax.set_xlabel("predicted (arcmin)")
+    axes[0].set_ylabel("measured (arcmin)")
+    fig.suptitle(title)
+    _save(fig, path)
+
+
+def residual_figure(points: pd.DataFrame, title: str, path) -> None:
+    """Residual D − S of the campaign model against each input (specimen means) and, for
+    curves, along the test by torque and branch; the found effects' residual beside it."""
+    curve = "torque_Nm" in points.columns and points["torque_Nm"].notna().any()
+    ncol = len(PARAMETERS) + (1 if curve else 0)
+    fig, axes = plt.subplots(1, ncol, figsize=(3 * ncol, 3.2), sharey=True)
+    r0 = points["D"] - points["S_model"]
+    r1 = points["D"] - points["S_final"]
+    spec = points.assign(r0=r0, r1=r1).groupby("specimen_id").agg(
+        r0=("r0", "mean"), r1=("r1", "mean"), **{c: (c, "first") for c in PARAMETER_COLUMNS})
+    for ax, p, col in zip(axes, PARAMETERS, PARAMETER_COLUMNS):
+        ax.plot(spec[col], spec["r0"], "o", mfc="none", label="campaign model")
+        ax.plot(spec[col], spec["r1"], "x", label="with found effects")
+        ax.axhline(0, color="k", lw=0.6)
+        ax.set_xlabel(_label(p))
+    axes[0].set_ylabel("mean residual D − S (arcmin)")
+    if curve:
+        ax = axes[-1]
+        pts = points.assign(r0=r0)
+        for br, g in pts.groupby("branch", sort=True) if "branch" in pts else [("all", pts)]:
+            ax.plot(g["torque_Nm"], g["r0"], ".", ms=3, label=br)
+        ax.axhline(0, color="k", lw=0.6)
+        ax.set_xlabel("torque (N m)")
+        ax.set_title("along the curve (campaign model)", fontsize=9)
+        ax.legend(fontsize=7)
+    axes[0].legend(fontsize=7)
+    fig.suptitle(title)
+    _save(fig, path)
+
+
+def ladder_figure(ladder: pd.DataFrame, noise_arcmin: float | None, title: str, path) -> None:
+    """RMSE of each model variant of the ladder, falling rung by rung."""
+    fig, ax = plt.subplots(figsize=(6.5, 3.6))
+    x = np.arange(len(ladder))
+    ax.plot(x, ladder["rmse_arcmin"], "o-", color="tab:blue", label="RMSE (actual solves)")
+    for xi, r in zip(x, ladder["rmse_arcmin"]):
+        ax.annotate(f"{r:.4f}", (xi, r), textcoords="offset points", xytext=(4, 6), fontsize=8)
+    if noise_arcmin:
+        ax.axhline(noise_arcmin, color="tab:gray", ls="--", label=f"noise {noise_arcmin:.4f} arcmin")
+    ax.set_xticks(x, ladder["model"], rotation=15, fontsize=8)
+    ax.set_ylabel("RMSE (arcmin)")
+    ax.set_ylim(bottom=0)
+    ax.legend(fontsize=8)
+    ax.set_title(title, fontsize=10)
+    _save(fig, path)

@@ -1,0 +1,257 @@
+"""The FE model with effects switched on, at measured specimens: variants, tables, synthesis.
+
+A *variant* is the baseline FE model with some effects switched on at given values,
+``{effect: {param: value}}``; its key is a canonical string (``"baseline"``,
+``"thermal:delta_T_K=20"``, ``"fs_cup_torsion:K_Nm_per_rad=60000+thermal:delta_T_K=20"``).
+
+Reuse between candidates (what makes a campaign affordable):
+
+* one mesh per specimen, built once and shared by every variant of that specimen;
+* variants that differ only in effects acting in series at the output (``Effect.series``:
+  cup torsion, Oldham play) share one contact solve: their twist is the solved rim twist
+  plus the series element's, exactly;
+* the calibration of every candidate reads the per-specimen tables (each parameter's grid),
+  so it costs no solve at all (``hdwf.diagnosis``).
+"""
+
+from __future__ import annotations
+
+import math
+import multiprocessing as mp
+from dataclasses import dataclass
+import os
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+import pandas as pd
+
+from . import PARAMETER_COLUMNS
+from .effects import get as get_effect
+from .effects import model_changes, registry
+from .fe import ModelChanges, series_output_twist
+from .geometry import ARCMIN
+
+BASELINE = "baseline"
+_BLAS_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+TABLE_COLUMNS = ["specimen_id", "variant", "step", "torque_Nm", "twist_arcmin", "status"]
+
+
+def variant_key(effects: dict[str, dict[str, float]]) -> str:
+    if not effects:
+        return BASELINE
+    parts = []
+    for name in sorted(effects):
+        for p, v in sorted(effects[name].items()):
+            parts.append(f"{name}:{p}={float(v):.10g}")
+    return "+".join(parts)
+
+
+def parse_variant_key(key: str) -> dict[str, dict[str, float]]:
+    if key == BASELINE:
+        return {}
+    out: dict[str, dict[str, float]] = {}
+    for part in key.split("+"):
+        name, rest = part.split(":", 1)
+        p, v = rest.split("=", 1)
+        out.setdefault(name, {})[p] = float(v)
+    return out
+
+
+def candidate_names(fixed: dict | None = None) -> list[str]:
+    """Every registered effect that is not already part of the campaign's model."""
+    return [n for n in registry() if n not in (fixed or {})]
+
+
+def plan_variants(fixed: dict[str, dict[str, float]] | None = None,
+                  candidates: list[str] | None = None) -> list[dict]:
+    """The campaign model (baseline + ``fixed`` effects) and, for every candidate effect,
+    the model with that effect at each value of its parameter's grid (one parameter each)."""
+    fixed = dict(fixed or {})
+    candidates = candidate_names(fixed) if candidates is None else candidates
+    plan = [fixed]
+    for name in candidates:
+        eff = get_effect(name)
+        if len(eff.parameters) != 1:
+            raise ValueError(f"effect {name!r}: calibration handles one-parameter effects only")
+        p = eff.parameters[0]
+        for v in p.grid():
+            plan.append({**fixed, name: {p.name: v}})
+    return plan
+
+
+def _series_shift_arcmin(torque_Nm: np.ndarray, changes: ModelChanges) -> np.ndarray:
+    """What the series elements add to a solved curve (relative to its first point)."""
+    add = series_output_twist(np.zeros(len(torque_Nm)), np.asarray(torque_Nm) * 1000.0,
+                              changes) / ARCMIN
+    return add - add[0]
+
+
+def solve_variants(unit: str, params: dict[str, float], mesh, steps_per_ramp: int,
+                   variants: list[dict], specimen_id: str) -> pd.DataFrame:
+    """Solve one specimen for every variant (one contact solve per distinct FE part).
+
+    A variant whose solve fails gets ``status = "failed: <reason>"`` and NaN twists."""
+    from .fe import solve_lost_motion
+    from .fe_study import geometry_of
+
+    geom = geometry_of(unit, params)
+    solved: dict[ModelChanges, object] = {}
+    frames = []
+    for eff in variants:
+        ch = model_changes(eff)
+        fe_part = ch.fe_part()
+        if fe_part not in solved:
+            solved[fe_part] = solve_lost_motion(geom, mesh, steps_per_ramp=steps_per_ramp,
+                                                changes=fe_part)
+        res = solved[fe_part]
+        ok = res.status == "ok"
+        if ok:
+            tw = res.twist_arcmin + _series_shift_arcmin(res.torque_Nm, ch)
+            step, torque = res.step, res.torque_Nm
+        else:
+            step = np.arange(4 * steps_per_ramp + 1)
+            torque = np.full(step.size, np.nan)
+            tw = np.full(step.size, np.nan)
+        frames.append(pd.DataFrame({
+            "specimen_id": specimen_id, "variant": variant_key(eff),
+            "step": np.asarray(step, dtype="int64"), "torque_Nm": np.asarray(torque, float),
+            "twist_arcmin": np.asarray(tw, float),
+            "status": "ok" if ok else f"failed: {res.reason}"}))
+    return pd.concat(frames, ignore_index=True)[TABLE_COLUMNS]
+
+
+def _specimen_job(args):
+    unit, params, settings, steps, variants, sid = args
+    from .fe_study import _mesh, geometry_of
+
+    mesh = _mesh(geometry_of(unit, params), settings)
+    return solve_variants(unit, params, mesh, steps, variants, sid)
+
+
+def solve_specimens(unit: str, specimens: pd.DataFrame, settings: dict, steps_per_ramp: int,
+                    variants_of, jobs: int = 1) -> pd.DataFrame:
+    """``solve_variants`` for every specimen row (``variants_of(specimen_id)`` gives its list),
+    in ``jobs`` processes; rows in specimen order."""
+    tasks = [(unit, {c: float(r[c]) for c in PARAMETER_COLUMNS}, settings, steps_per_ramp,
+              variants_of(r["specimen_id"]), r["specimen_id"]) for _, r in specimens.iterrows()]
+    if jobs <= 1 or len(tasks) <= 1:
+        out = [_specimen_job(t) for t in tasks]
+    else:
+        # fresh interpreters with one BLAS thread each: the dense solves are small, and
+        # 2 processes x 2 BLAS threads on 2 cores only fight
+        saved = {k: os.environ.get(k) for k in _BLAS_VARS}
+        os.environ.update({k: "1" for k in _BLAS_VARS})
+        try:
+            with ProcessPoolExecutor(max_workers=jobs, mp_context=mp.get_context("spawn")) as ex:
+                out = list(ex.map(_specimen_job, tasks))
+        finally:
+            for k, v in saved.items():
+                if v is None:
+                    os.environ.pop(k, None)
+                else:
+                    os.environ[k] = v
+    return pd.concat(out, ignore_index=True)
+
+
+# ------------------------------------------------------------------ synthetic measurements
+
+def synth_designs(unit: str, n: int, seed: int) -> pd.DataFrame:
+    """``n`` specimens by Latin hypercube (seeded) over the paper's Table 3 ranges."""
+    from scipy.stats import qmc
+
+    from . import PARAMETERS
+    from .measurements import _TABLE3
+
+    bounds = _TABLE3[unit]
+    lo = np.array([bounds[p][0] for p in PARAMETERS])
+    hi = np.array([bounds[p][1] for p in PARAMETERS])
+    u = qmc.LatinHypercube(d=len(PARAMETERS), seed=seed).random(n)
+    x = qmc.scale(u, lo, hi)
+    df = pd.DataFrame(x, columns=list(PARAMETER_COLUMNS))
+    df.insert(0, "unit", unit)
+    df.insert(0, "specimen_id", [f"{unit}-s{i + 1:03d}" for i in range(n)])
+    return df
+
+
+def synthesize(unit: str, n_designs: int, seed: int, noise_arcmin: float,
+               effects: dict[str, dict[str, float]] | None, settings: dict,
+               steps_per_ramp: int = 5, jobs: int = 1) -> pd.DataFrame:
+    """Measurements in the documented curve form from the FE model with ``effects`` on:
+    the solved curve of each specimen plus Gaussian noise of ``noise_arcmin`` (seeded),
+    with ``u_twist_arcmin`` = the noise level. A failed solve raises (no silent rows)."""
+    if noise_arcmin < 0 or not math.isfinite(noise_arcmin):
+        raise ValueError(f"noise_arcmin must be >= 0, got {noise_arcmin!r}")
+    specimens = synth_designs(unit, n_designs, seed)
+    effects = effects or {}
+    model_changes(effects)    # checks names, parameters and bounds before any solve
+    table = solve_specimens(unit, specimens, settings, steps_per_ramp, lambda _: [effects], jobs)
+    bad = table[table["status"] != "ok"]
+    if len(bad):
+        raise RuntimeError(f"synthesis: the FE solve failed for specimen "
+                           f"{bad['specimen_id'].iloc[0]}: {bad['status'].iloc[0]}")
+    rng = np.random.default_rng(seed)
+    data = specimens.merge(table.drop(columns=["variant", "status"]), on="specimen_id")
+    data["twist_arcmin"] = data["twist_arcmin"] + rng.normal(0.0, noise_arcmin, len(data))
+    data["u_twist_arcmin"] = noise_arcmin
+    return data[["specimen_id", "unit", *PARAMETER_COLUMNS, "step", "torque_Nm", "twist_arcmin",
+                 "u_twist_arcmin"]]
+
+
+# ------------------------------------------------------------------ campaigns (workflow stages)
+
+@dataclass
+class CampaignPlan:
+    """A validation campaign from ``config.yaml`` (``validation: {NAME: ...}``), resolved."""
+    name: str
+    unit: str
+    measurements: str
+    fixed: dict            # effects switched on at given values
+    calibrate_first: list  # effects switched on and calibrated before the search
+    candidates: list       # effects the diagnosis tries
+    rounds: int
+    settings: dict         # mesh settings of its solves
+    steps_per_ramp: int
+
+    def table_variants(self) -> list[dict]:
+        return plan_variants(self.fixed, self.candidates)
+
+
+def campaign_plan(name: str, camp: dict, fe: dict) -> CampaignPlan:
+    fixed, calib = {}, []
+    for eff, params in camp.get("effects", {}).items():
+        if any(v == "calibrate" for v in params.values()):
+            calib.append(eff)
+        else:
+            fixed[eff] = {p: float(v) for p, v in params.items()}
+    cands = camp.get("candidates", "all")
+    cands = candidate_names(fixed) if cands == "all" else [c for c in cands if c not in fixed]
+    cands = sorted(set(cands) | set(calib))
+    mesh = camp.get("mesh", {})
+    settings = {"elements_over_height": mesh.get("elements_over_height", fe["elements_over_height"]),
+                "elements_over_thickness": mesh.get("elements_over_thickness", fe["elements_over_thickness"]),
+                "refinement": mesh.get("refinement", fe["refinement"]),
+                "symmetry": fe.get("symmetry", "full")}
+    return CampaignPlan(name, camp["unit"], camp["measurements"], fixed, calib, cands,
+                        int(camp.get("rounds", 2)), settings, int(fe["steps_per_ramp"]))
+
+
+def specimen_stage(unit: str, specimen: dict, settings: dict, steps_per_ramp: int, variants: list[dict],
+                   out, provenance: dict, reuse=None) -> pd.DataFrame:
+    """Mesh one specimen once and solve it for every variant; rows already in ``reuse``
+    (a table of the same specimen and mesh) are copied, not solved again."""
+    from .fe_study import _mesh, geometry_of
+    from .io import write_parquet
+
+    sid = specimen["specimen_id"]
+    params = {c: float(specimen[c]) for c in PARAMETER_COLUMNS}
+    have = pd.read_parquet(reuse) if reuse else pd.DataFrame(columns=TABLE_COLUMNS)
+    keys = [variant_key(v) for v in variants]
+    todo = [v for v, k in zip(variants, keys) if k not in set(have["variant"])]
+    frames = [have[have["variant"].isin(keys)]]
+    if todo:
+        mesh = _mesh(geometry_of(unit, params), settings)
+        frames.append(solve_variants(unit, params, mesh, steps_per_ramp, todo, sid))
+    table = pd.concat(frames, ignore_index=True)[TABLE_COLUMNS]
+    write_parquet(table, out, provenance=provenance,
+                  meta={"unit": unit, "specimen_id": sid, "mesh": settings})
+    return table

@@ -1,0 +1,441 @@
+"""Which physical effect is the model missing? Calibrate every candidate, rank, decide.
+
+Inputs: checked measurements (``hdwf.measurements``) and the per-specimen tables of the FE
+model (``hdwf.campaign``): the campaign's model and, for every candidate effect, the model
+with that effect at each value of its parameter's grid.
+
+Method (hand-written around scipy/statsmodels; see docs/validation.md):
+
+* an effect's prediction at parameter t (its ``transform``: t = 0 is "off") is the cubic
+  spline through the tabulated values, point by point;
+* effects found earlier stay on; a new candidate is added by superposition of its change
+  (exact when one of the two acts in series at the output, an approximation otherwise,
+  which the ladder's actual solves check) and all switched-on parameters are calibrated
+  together by bounded least squares (``scipy.optimize.least_squares``), with covariance
+  s^2 (J^T J)^-1;
+* evidence: ΔBIC against the model without the candidate, the leave-one-specimen-out error
+  (recalibrated without that specimen), and how well the change the effect makes lines up
+  with the residual it should explain (cosine: 1 = the same pattern);
+* verdict (``hdwf.validation.verdict``): a candidate pays when ΔBIC <= -10 and its
+  leave-one-out error beats the current model's; paying candidates within ΔBIC 6 of the
+  best are reported as indistinguishable; none paying -> "no missing effect found";
+* greedy: the winner is switched on and the search repeats for the next effect.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from scipy.interpolate import make_interp_spline
+from scipy.optimize import least_squares
+
+from .campaign import BASELINE, parse_variant_key, variant_key
+from .effects import get as get_effect
+from .validation import Candidate, bic, comparison_points, residual_tests, summarise, verdict
+
+
+# ------------------------------------------------------------------ observations
+
+def observation_frame(meas) -> pd.DataFrame:
+    """The measured values as one column ``D`` with their keys (specimen_id [, step]) and
+    ``quantity`` (twist, phi_plus, phi_minus or lost_motion), and ``u_D`` when given."""
+    d = meas.data
+    if meas.form == "curve":
+        out = d[["specimen_id", "step", "torque_Nm", "twist_arcmin"]].rename(columns={"twist_arcmin": "D"})
+        out["quantity"] = "twist"
+        out["u_D"] = d["u_twist_arcmin"].to_numpy(float) if "u_twist_arcmin" in d else np.nan
+    elif meas.form == "phi":
+        parts = []
+        for q in ("phi_plus", "phi_minus"):
+            part = d[["specimen_id"]].copy()
+            part["D"] = d[f"{q}_arcmin"].to_numpy(float)
+            part["quantity"] = q
+            part["u_D"] = d["u_arcmin"].to_numpy(float) if "u_arcmin" in d else np.nan
+            parts.append(part)
+        out = pd.concat(parts, ignore_index=True)
+    else:
+        out = d[["specimen_id"]].copy()
+        out["D"] = d["lost_motion_arcmin"].to_numpy(float)
+        out["quantity"] = "lost_motion"
+        out["u_D"] = d["u_arcmin"].to_numpy(float) if "u_arcmin" in d else np.nan
+    return out.reset_index(drop=True)
+
+
+def predict(table: pd.DataFrame, obs: pd.DataFrame, variant: str) -> np.ndarray:
+    """The model's value of every observation for one variant (NaN where its solve failed)."""
+    t = table[table["variant"] == variant]
+    if t.empty:
+        raise KeyError(f"variant {variant!r} is not in the table")
+    out = np.full(len(obs), np.nan)
+    curves = {sid: g.sort_values("step") for sid, g in t.groupby("specimen_id", sort=False)}
+    for i, (sid, q) in enumerate(zip(obs["specimen_id"], obs["quantity"])):
+        g = curves.get(sid)
+        if g is None:
+            raise KeyError(f"specimen {sid!r} has no solve for variant {variant!r}")
+        tw = g["twist_arcmin"].to_numpy(float)
+        T = g["torque_Nm"].to_numpy(float)
+        if q == "twist":
+            out[i] = tw[g["step"].to_numpy() == obs["step"].iloc[i]][0]
+        else:
+            kp, km = int(np.nanargmax(T)), int(np.nanargmin(T))
+            phi_p, phi_m = tw[kp], -tw[km]
+            out[i] = {"phi_plus": phi_p, "phi_minus": phi_m, "lost_motion": phi_p + phi_m}[q]
+    return out
+
+
+@dataclass
+class Response:
+    """The prediction of every observation as a function of one effect's parameter t."""
+    effect: str
+    param: str
+    t: np.ndarray          # sorted grid in the transformed parameter (includes 0 = off)
+    S: np.ndarray          # (len(t), n_obs)
+    t_bounds: tuple[float, float]
+
+    def __post_init__(self):
+        k = min(3, len(self.t) - 1)
+        self._spline = make_interp_spline(self.t, self.S, k=k, axis=0)
+
+    def at(self, t: float) -> np.ndarray:
+        return self._spline(float(t))
+
+    def change(self, t: float) -> np.ndarray:
+        """Prediction at t minus the prediction with the effect off."""
+        return self._spline(float(t)) - self._spline(0.0)
+
+    def value(self, t: float) -> float:
+        return get_effect(self.effect).param(self.param).from_t(t)
+
+
+def responses(table: pd.DataFrame, obs: pd.DataFrame, fixed: dict, candidates: list[str],
+              notes: dict | None = None) -> dict[str, Response]:
+    """Each candidate's tabulated response. A grid value whose solve failed for any specimen
+    is dropped and the calibration range shrinks to the values that solved (``notes``
+    records it); a candidate left with fewer than two values is not calibrated at all."""
+    base = variant_key(fixed)
+    S0 = predict(table, obs, base)
+    out = {}
+    for name in candidates:
+        eff = get_effect(name)
+        p = eff.parameters[0]
+        ts, Ss, dropped = [0.0], [S0], []
+        for v in p.grid():
+            key = variant_key({**fixed, name: {p.name: v}})
+            S = predict(table, obs, key)
+            if np.isfinite(S).all():
+                ts.append(p.to_t(v))
+                Ss.append(S)
+            else:
+                dropped.append(v)
+        if notes is not None and dropped:
+            notes[name] = (f"solve failed at {p.name} = {', '.join(f'{v:g}' for v in dropped)}; "
+                           "calibrated over the values that solved")
+        if len(ts) < 2:
+            if notes is not None:
+                notes[name] = f"every grid solve failed; not calibrated"
+            continue
+        order = np.argsort(ts)
+        lo, hi = p.t_bounds
+        tb = (max(lo, min(ts)), min(hi, max(ts)))
+        out[name] = Response(name, p.name, np.asarray(ts)[order], np.asarray(Ss)[order], tb)
+    return out
+
+
+# ------------------------------------------------------------------ calibration
+
+@dataclass
+class Fit:
+    effects: list[str]
+    t: np.ndarray
+    cov_t: np.ndarray
+    S: np.ndarray          # prediction at the calibrated values
+    rss: float
+    n: int
+
+    def params(self, resp: dict[str, Response]) -> dict[str, dict[str, float]]:
+        """Calibrated values; an effect calibrated to "off" (t ~ 0) gets its off value."""
+        out = {}
+        for e, t in zip(self.effects, self.t):
+            lo, hi = resp[e].t_bounds
+            off = abs(t) <= 1e-6 * max(abs(lo), abs(hi))
+            out[e] = {resp[e].param: float(get_effect(e).off.get(resp[e].param, 0.0)) if off
+                      else float(resp[e].value(t))}
+        return out
+
+    def param_sd(self, resp: dict[str, Response]) -> dict[str, float]:
+        """Standard uncertainty of each calibrated parameter, in its own unit."""
+        out = {}
+        for k, (e, t) in enumerate(zip(self.effects, self.t)):
+            sd_t = math.sqrt(max(self.cov_t[k, k], 0.0))
+            p = get_effect(e).param(resp[e].param)
+            out[e] = sd_t / t ** 2 if p.transform == "reciprocal" and t != 0 else sd_t
+        return out
+
+
+def _model(S0, resp, effects, t):
+    S = S0.copy()
+    for e, tk in zip(effects, t):
+        S = S + resp[e].change(tk)
+    return S
+
+
+def calibrate(D: np.ndarray, S0: np.ndarray, resp: dict[str, Response], effects: list[str],
+              start: list[float] | None = None, mask: np.ndarray | None = None) -> Fit:
+    """Least squares on the measurements over the parameters of ``effects`` (jointly)."""
+    m = np.ones(len(D), bool) if mask is None else mask
+    lo = np.array([resp[e].t_bounds[0] for e in effects])
+    hi = np.array([resp[e].t_bounds[1] for e in effects])
+    if start is None:
+        start = []
+    x0 = list(start)
+    # a new effect starts at the best point of a scan of its range (the fit is not convex
+    # in general: dead bands and friction change which teeth carry the load)
+    for k in range(len(x0), len(effects)):
+        grid = np.linspace(lo[k], hi[k], 41)
+        rss = [np.sum((D[m] - _model(S0, resp, effects, x0 + [g] + [0.0] * (len(effects) - k - 1))[m]) ** 2)
+               for g in grid]
+        x0.append(float(grid[int(np.argmin(rss))]))
+    scale = np.maximum(hi - lo, 1e-300)
+
+    def res(z):
+        return (_model(S0, resp, effects, lo + z * scale) - D)[m]
+
+    z0 = np.clip((np.asarray(x0) - lo) / scale, 0, 1)
+    sol = least_squares(res, z0, bounds=(0.0, 1.0), x_scale=1.0, diff_step=1e-4, method="trf")
+    t = lo + sol.x * scale
+    S = _model(S0, resp, effects, t)
+    r = (S - D)[m]
+    n = int(m.sum())
+    J = sol.jac / scale[None, :]
+    s2 = float(r @ r) / max(n - len(effects), 1)
+    try:
+        cov = s2 * np.linalg.inv(J.T @ J)
+    except np.linalg.LinAlgError:
+        cov = np.full((len(effects), len(effects)), np.inf)
+    return Fit(list(effects), t, cov, S, float(r @ r), n)
+
+
+def loo_rmse(D, S0, resp, effects, fit: Fit, specimen: np.ndarray) -> float:
+    """Leave one specimen out: calibrate on the others, predict the one left out."""
+    if not effects:
+        return float(np.sqrt(np.mean((S0 - D) ** 2)))
+    err = np.zeros(len(D))
+    for sid in pd.unique(specimen):
+        out = specimen == sid
+        f = calibrate(D, S0, resp, effects, start=list(fit.t), mask=~out)
+        err[out] = (f.S - D)[out]
+    return float(np.sqrt(np.mean(err ** 2)))
+
+
+def _cosine(a: np.ndarray, b: np.ndarray) -> float:
+    na, nb = np.linalg.norm(a), np.linalg.norm(b)
+    return float(a @ b / (na * nb)) if na > 0 and nb > 0 else 0.0
+
+
+# ------------------------------------------------------------------ the diagnosis
+
+def diagnose(meas, table: pd.DataFrame, fixed: dict | None = None, calibrate_first: list[str] | None = None,
+             candidates: list[str] | None = None, max_rounds: int = 2, pay_threshold: float = 10.0,
+             tie_threshold: float = 6.0) -> tuple[dict, pd.DataFrame]:
+    """The campaign's diagnosis (the content of ``diagnosis.json``) and its comparison points
+    (one row per observation: measured ``D``, the campaign model ``S_model`` and the model
+    with every found effect at its calibrated value ``S_final``)."""
+    from .campaign import candidate_names
+
+    fixed = dict(fixed or {})
+    calibrate_first = list(calibrate_first or [])
+    if candidates is None:
+        candidates = candidate_names(fixed)
+    obs = observation_frame(meas)
+    D = obs["D"].to_numpy(float)
+    spec = obs["specimen_id"].to_numpy()
+    S0 = predict(table, obs, variant_key(fixed))
+    failed = ~np.isfinite(S0)
+    if failed.any():
+        bad = sorted(set(spec[failed]))
+        raise RuntimeError(f"the campaign model failed to solve for specimen(s) {', '.join(bad)}; "
+                           "see their tables' status")
+    notes: dict[str, str] = {}
+    resp = responses(table, obs, fixed, candidates, notes)
+    candidates = [c for c in candidates if c in resp]
+
+    on: list[str] = []
+    fit = Fit([], np.zeros(0), np.zeros((0, 0)), S0, float(np.sum((S0 - D) ** 2)), len(D))
+    for e in calibrate_first:                        # effects the campaign says to calibrate
+        on.append(e)
+        fit = calibrate(D, S0, resp, on, start=list(fit.t))
+    rounds = []
+    remaining = [c for c in candidates if c not in on]
+    for rnd in range(1, max_rounds + 1):
+        cur = Candidate("current model", {}, fit.rss, len(D), len(on), loo_rmse(D, S0, resp, on, fit, spec))
+        resid = D - fit.S
+        cands, extra = [], {}
+        for e in remaining:
+            f = calibrate(D, S0, resp, on + [e], start=list(fit.t))
+            cands.append(Candidate(e, f.params(resp)[e], f.rss, len(D), len(on) + 1,
+                                   loo_rmse(D, S0, resp, on + [e], f, spec)))
+            t_e = f.t[-1]
+            lo, hi = resp[e].t_bounds
+            tol = 1e-6 * max(abs(lo), abs(hi))
+            extra[e] = {"param_sd": f.param_sd(resp)[e],
+                        "signature_match": _cosine(resid, f.S - fit.S),
+                        "at_bound": bool(abs(t_e) > tol and (abs(t_e - lo) <= tol or abs(t_e - hi) <= tol)),
+                        "off": bool(abs(t_e) <= tol),
+                        "fit": f}
+        v = verdict(cur, cands, pay_threshold, tie_threshold)
+        for r in v["ranking"]:
+            x = extra[r["effect"]]
+            r.update({"param_sd": None if x["off"] else x["param_sd"],
+                      "signature_match": x["signature_match"], "at_bound": x["at_bound"],
+                      "calibrated_off": x["off"], "signature": get_effect(r["effect"]).signature})
+        rounds.append({"round": rnd, "model_effects": list(on), "current_rmse_arcmin": cur.rmse,
+                       "ranking": v["ranking"], "verdict": v["verdict"]})
+        winner = v["verdict"]["missing_effect"]
+        if winner is None:
+            break
+        on.append(winner)
+        fit = extra[winner]["fit"]
+        remaining.remove(winner)
+        if not remaining:
+            break
+
+    base_points = comparison_points(_measured_for_points(obs), _predicted_for_points(obs, S0), "value")
+    for c in meas.specimens.columns:
+        if c.endswith("_mm") and c not in base_points:
+            base_points = base_points.merge(meas.specimens[["specimen_id", c]], on="specimen_id")
+    summary, per = summarise(base_points)
+    tests = residual_tests(base_points)
+    first = rounds[0]
+    found = [{"effect": e, "params": fit.params(resp)[e], "param_sd": fit.param_sd(resp)[e]} for e in on]
+    final_rmse = float(np.sqrt(fit.rss / len(D)))
+    noise = float(np.sqrt(np.nanmean(obs["u_D"].to_numpy(float) ** 2))) if np.isfinite(obs["u_D"]).any() else None
+    points = obs.copy()
+    points["S_model"] = S0
+    points["S_final"] = fit.S
+    points = points.merge(meas.specimens[["specimen_id", *[c for c in meas.specimens.columns
+                                                            if c.endswith("_mm")]]], on="specimen_id")
+    if "branch" in base_points:
+        points["branch"] = base_points["branch"].to_numpy()
+    result = {
+        "form": meas.form, "n_points": int(len(D)), "n_specimens": int(len(pd.unique(spec))),
+        "noise_arcmin": noise,
+        "model": {"fixed": fixed, "calibrated_first": calibrate_first},
+        "baseline": {"rmse_arcmin": summary.rmse, "bias_arcmin": summary.bias,
+                     "max_abs_arcmin": summary.max_abs, "worst_specimen": summary.worst_specimen,
+                     "u_val_arcmin": None if math.isnan(summary.u_val) else summary.u_val,
+                     "share_beyond_2uval": None if math.isnan(summary.share_beyond_2uval)
+                     else summary.share_beyond_2uval},
+        "ranking": first["ranking"],
+        "verdict": {**first["verdict"],
+                    "found_in_order": [f["effect"] for f in found if f["effect"] not in calibrate_first]},
+        "rounds": rounds,
+        "found": found,
+        "final": {"effects": fit.params(resp), "rmse_arcmin": final_rmse,
+                  "rmse_over_noise": (final_rmse / noise) if noise else None},
+        "notes": notes,
+        "worst_specimens": per.head(5).to_dict(orient="records"),
+        "residual_tests": tests.to_dict(orient="records"),
+    }
+    return result, points
+
+
+def _measured_for_points(obs: pd.DataFrame) -> pd.DataFrame:
+    m = obs.rename(columns={"D": "value"}).copy()
+    m["step"] = m["step"] if "step" in m else np.arange(len(m))
+    if "u_D" in m:
+        m["u_arcmin"] = m["u_D"]
+    return m.drop(columns=["u_D"])
+
+
+def _predicted_for_points(obs: pd.DataFrame, S: np.ndarray) -> pd.DataFrame:
+    p = obs[["specimen_id"]].copy()
+    p["step"] = obs["step"] if "step" in obs else np.arange(len(obs))
+    p["value"] = S
+    return p
+
+
+def ladder_variants(diagnosis: dict) -> list[tuple[str, dict]]:
+    """The model variants of the ladder, in order: the bare baseline, the campaign's model,
+    then each found effect switched on at its calibrated value (cumulative)."""
+    fixed = diagnosis["model"]["fixed"]
+    rungs = [("baseline", {})]
+    if fixed:
+        rungs.append(("campaign model", dict(fixed)))
+    cur = dict(fixed)
+    for f in diagnosis["found"]:
+        cur = {**cur, f["effect"]: f["params"]}
+        rungs.append((f"+ {f['effect']}", dict(cur)))
+    return rungs
+
+
+def ladder_table(meas, table: pd.DataFrame, diagnosis: dict) -> pd.DataFrame:
+    """One row per model variant of the ladder, from actual solves (``table``)."""
+    import json
+
+    obs = observation_frame(meas)
+    D = obs["D"].to_numpy(float)
+    rows, b0 = [], None
+    for k, (label, eff) in enumerate(ladder_variants(diagnosis)):
+        S = predict(table, obs, variant_key(eff))
+        n_par = sum(len(v) for v in eff.values())
+        rss = float(np.nansum((S - D) ** 2))
+        b = bic(rss, len(D), n_par)
+        b0 = b if b0 is None else b0
+        rows.append({"rung": k, "model": label, "effects": json.dumps(eff, sort_keys=True),
+                     "n_params": n_par, "rmse_arcmin": float(np.sqrt(rss / len(D))),
+                     "bias_arcmin": float(np.nanmean(S - D)), "max_abs_arcmin": float(np.nanmax(np.abs(S - D))),
+                     "delta_bic": float(b - b0), "solved": bool(np.isfinite(S).all())})
+    return pd.DataFrame(rows)
+
+
+__all__ = ["diagnose", "ladder_table", "ladder_variants", "calibrate", "observation_frame", "predict",
+           "responses", "BASELINE", "parse_variant_key"]
+
+
+def json_safe(obj):
+    """JSON without NaN/inf (null instead), numpy scalars as Python numbers."""
+    if isinstance(obj, dict):
+        return {str(k): json_safe(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [json_safe(v) for v in obj]
+    if isinstance(obj, (np.floating, float)):
+        return float(obj) if math.isfinite(obj) else None
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    return obj
+
+
+# ------------------------------------------------------------------ workflow stages
+
+def diagnosis_stage(measurements_path, table_paths, plan, out_json, out_points, provenance: dict) -> dict:
+    """Diagnose one campaign from its measurement file and per-specimen tables."""
+    from .io import write_json, write_parquet
+    from .measurements import load_measurements
+
+    meas = load_measurements(measurements_path)
+    table = pd.concat([pd.read_parquet(p) for p in table_paths], ignore_index=True)
+    result, points = diagnose(meas, table, plan.fixed, plan.calibrate_first, plan.candidates, plan.rounds)
+    result = {"campaign": plan.name, "unit": plan.unit, "measurements": str(measurements_path),
+              "mesh": plan.settings, **result, "provenance": provenance}
+    write_parquet(points, out_points, provenance=provenance, meta={"campaign": plan.name, "unit": plan.unit})
+    write_json(json_safe(result), out_json)
+    return result
+
+
+def ladder_stage(measurements_path, diagnosis_json, table_paths, out, provenance: dict) -> pd.DataFrame:
+    import json
+
+    from .io import write_parquet
+    from .measurements import load_measurements
+
+    meas = load_measurements(measurements_path)
+    diag = json.loads(open(diagnosis_json).read())
+    table = pd.concat([pd.read_parquet(p) for p in table_paths], ignore_index=True)
+    ladder = ladder_table(meas, table, diag)
+    write_parquet(ladder, out, provenance=provenance, meta={"campaign": diag["campaign"], "unit": diag["unit"]})
+    return ladder

@@ -1,0 +1,139 @@
+"""Candidate physical effects that the baseline FE model lacks: the registry.
+
+Each effect is one module in this package that defines ``EFFECT = Effect(...)``: a name,
+a physical description, its parameters (units, bounds, a realistic value) and the
+signature it leaves in the torque–twist curve, plus ``apply``, which turns parameter values
+into a change of the FE model (``hdwf.fe.ModelChanges``), never a correction of its output.
+The registry imports every module of the package by itself, so adding an effect is adding
+one file (``docs/adding-an-effect.md``).
+
+Calibration needs the model response over each parameter's range. Every parameter has a
+``transform`` in which that response is close to linear and zero means "effect off":
+``linear`` (the value itself, e.g. a friction coefficient) or ``reciprocal`` (1/value,
+e.g. a stiffness, whose compliance adds) — and a ``grid`` of values the per-specimen
+solves tabulate.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+import pkgutil
+from dataclasses import dataclass, field
+from typing import Callable
+
+from ..fe import ModelChanges
+
+
+@dataclass(frozen=True)
+class Parameter:
+    name: str
+    unit: str
+    lower: float
+    upper: float
+    realistic: float          # a typical value (synthetic data, documentation)
+    description: str
+    transform: str = "linear"  # "linear" or "reciprocal": response ~ linear in it, 0 = off
+    grid_points: int = 4       # tabulated values besides "off" (for FE-level effects)
+
+    def to_t(self, value: float) -> float:
+        return 1.0 / value if self.transform == "reciprocal" else float(value)
+
+    def from_t(self, t: float) -> float:
+        if self.transform == "reciprocal":
+            return math.inf if t == 0 else 1.0 / t
+        return float(t)
+
+    @property
+    def t_bounds(self) -> tuple[float, float]:
+        a, b = self.to_t(self.lower), self.to_t(self.upper)
+        lo, hi = min(a, b), max(a, b)
+        return (min(lo, 0.0), max(hi, 0.0))
+
+    def grid(self) -> list[float]:
+        """Parameter values to tabulate: evenly spaced in t over the bounds, without "off"."""
+        lo, hi = self.t_bounds
+        n = self.grid_points
+        ts = [lo + (hi - lo) * k / n for k in range(n + 1)]
+        return [self.from_t(t) for t in ts if t != 0.0]
+
+    def check(self, value: float, where: str) -> float:
+        v = float(value)
+        if not (self.lower <= v <= self.upper):
+            raise ValueError(f"{where}: {self.name} = {value!r} {self.unit} is outside "
+                             f"[{self.lower:g}, {self.upper:g}]")
+        return v
+
+
+@dataclass(frozen=True)
+class Effect:
+    name: str
+    title: str
+    description: str
+    signature: str
+    parameters: tuple[Parameter, ...]
+    apply: Callable[..., ModelChanges]   # (changes, **params) -> changes
+    series: bool = False                 # acts in series at the output: no new contact solve
+    references: str = ""
+    off: dict = field(default_factory=dict)   # parameter values that switch it off
+
+    def param(self, name: str) -> Parameter:
+        for p in self.parameters:
+            if p.name == name:
+                return p
+        raise KeyError(f"effect {self.name!r} has no parameter {name!r} "
+                       f"(has: {', '.join(p.name for p in self.parameters)})")
+
+
+def registry() -> dict[str, Effect]:
+    """Every effect module of this package, by name (imported on first use)."""
+    out: dict[str, Effect] = {}
+    for info in sorted(pkgutil.iter_modules(__path__), key=lambda i: i.name):
+        if info.name.startswith("_"):
+            continue
+        mod = importlib.import_module(f"{__name__}.{info.name}")
+        eff = getattr(mod, "EFFECT", None)
+        if not isinstance(eff, Effect):
+            raise TypeError(f"hdwf.effects.{info.name} defines no EFFECT = Effect(...)")
+        if eff.name in out:
+            raise ValueError(f"two effects are named {eff.name!r}")
+        out[eff.name] = eff
+    return out
+
+
+def get(name: str) -> Effect:
+    reg = registry()
+    if name not in reg:
+        raise KeyError(f"unknown effect {name!r}; known: {', '.join(reg)}")
+    return reg[name]
+
+
+def model_changes(effects: dict[str, dict[str, float]] | None) -> ModelChanges:
+    """The FE-model changes of a set of switched-on effects {name: {param: value}}."""
+    ch = ModelChanges()
+    for name, params in (effects or {}).items():
+        eff = get(name)
+        values = {}
+        for p in eff.parameters:
+            if p.name not in params:
+                raise ValueError(f"effect {name!r}: parameter {p.name!r} is missing")
+            values[p.name] = p.check(params[p.name], f"effect {name!r}")
+        unknown = set(params) - {p.name for p in eff.parameters}
+        if unknown:
+            raise ValueError(f"effect {name!r}: unknown parameter(s) {sorted(unknown)}")
+        ch = eff.apply(ch, **values)
+    return ch
+
+
+def parse_assignment(text: str) -> tuple[str, str, float]:
+    """``NAME:PARAM=VALUE`` (command line) -> (effect, parameter, value), checked."""
+    try:
+        name, rest = text.split(":", 1)
+        pname, value = rest.split("=", 1)
+        v = float(value)
+    except ValueError:
+        raise ValueError(f"--effect {text!r}: expected NAME:PARAM=VALUE, e.g. "
+                         "tooth_friction:mu=0.08") from None
+    eff = get(name)
+    eff.param(pname).check(v, f"--effect {text!r}")
+    return name, pname, v

@@ -1,0 +1,152 @@
+"""Hidden-effect tests: data synthesised from the FE model with an effect switched on, noise
+added; the diagnosis must find that effect, recover its parameter and bring the error down
+to the noise — and must not invent an effect when there is none.
+
+Coarse mesh (5 elements over the tooth height, 3 over its thickness, half model), 12 HD 42
+specimens. The model tables (campaign model + every candidate's grid) depend on the specimens
+only, so they are solved once for the module and shared by every test.
+
+Noise levels. Our 2D model's lost motion is dominated by its dead band (about 9 arcmin on
+this mesh, docs/fe-model.md), so noise of 2 % of the lost motion (0.18 arcmin per point)
+hides every elastic effect at a realistic value: cup torsion and housing compliance change
+the twist at ±T by about 0.05 and 0.02 arcmin, friction by 0.01. The dead-band effects
+(thermal, Oldham play) are tested at 2 % of the signal, as the issue asks; every effect is
+also tested at bench-like noise of 0.2 % of the signal (about 1 arcsec, an encoder's
+resolution). Flank friction is not identifiable even there (its loop is 0.1 % of the
+signal); that test is marked xfail with the measured reason rather than weakened.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hdwf.campaign import (plan_variants, solve_specimens, synth_designs, synthesize,
+                           variant_key)
+from hdwf.diagnosis import diagnose
+from hdwf.measurements import load_measurements
+
+UNIT = "hd42"
+N_SPECIMENS = 12
+SEED = 11
+SETTINGS = dict(elements_over_height=5, elements_over_thickness=3, refinement=1.0, symmetry="half")
+JOBS = 2
+
+REALISTIC = {
+    "thermal": ("delta_T_K", 10.0),
+    "oldham_play": ("play_arcsec", 10.0),
+    "fs_cup_torsion": ("K_Nm_per_rad", 6.0e4),
+    "cs_housing": ("k_N_per_mm2", 5.0e3),
+    "tooth_friction": ("mu", 0.08),
+}
+
+
+@pytest.fixture(scope="module")
+def specimens():
+    return synth_designs(UNIT, N_SPECIMENS, SEED)
+
+
+@pytest.fixture(scope="module")
+def tables(specimens):
+    plan = plan_variants({})
+    return solve_specimens(UNIT, specimens, SETTINGS, 5, lambda _: plan, jobs=JOBS)
+
+
+@pytest.fixture(scope="module")
+def signal(tables):
+    """Mean lost motion of the specimens (the twist range of each baseline curve)."""
+    base = tables[tables["variant"] == "baseline"]
+    return float(base.groupby("specimen_id")["twist_arcmin"].agg(lambda t: t.max() - t.min()).mean())
+
+
+def _measure(tmp_path, specimens, effects, noise, seed=5):
+    """``hdwf synth`` in-process: same specimens as the tables, the hidden effects on."""
+    data = synthesize(UNIT, N_SPECIMENS, SEED, noise, effects, SETTINGS, jobs=JOBS)
+    # the synthesiser draws the same Latin hypercube: the specimens must be the tables' ones
+    pd.testing.assert_frame_equal(data.drop_duplicates("specimen_id")[specimens.columns].reset_index(drop=True),
+                                  specimens.reset_index(drop=True))
+    path = tmp_path / "measured.csv"
+    data.to_csv(path, index=False)
+    return load_measurements(path)
+
+
+def _rmse_switched_on(meas, specimens, effects):
+    """RMSE of the model with the calibrated effects switched on: actual solves, not the tables."""
+    table = solve_specimens(UNIT, specimens, SETTINGS, 5, lambda _: [effects], jobs=JOBS)
+    pred = table[["specimen_id", "step", "twist_arcmin"]].rename(columns={"twist_arcmin": "S"})
+    pts = meas.data.merge(pred, on=["specimen_id", "step"])
+    return float(np.sqrt(np.mean((pts["S"] - pts["twist_arcmin"]) ** 2)))
+
+
+def _check_found(diag, effect, param, true, meas, specimens, noise):
+    verdict = diag["verdict"]
+    named = verdict["missing_effect"] == effect or effect in verdict["indistinguishable_from"]
+    assert named, verdict
+    entry = next(r for r in diag["ranking"] if r["effect"] == effect)
+    est = entry["params"][param]
+    assert est == pytest.approx(true, rel=0.15), (effect, est, true)
+    rmse = _rmse_switched_on(meas, specimens, {effect: {param: est}})
+    assert rmse <= 1.3 * noise, (effect, rmse, noise)
+
+
+@pytest.mark.parametrize("effect", ["thermal", "oldham_play"])
+def test_dead_band_effect_found_at_two_percent_noise(tmp_path, specimens, tables, signal, effect):
+    param, true = REALISTIC[effect]
+    noise = 0.02 * signal
+    meas = _measure(tmp_path, specimens, {effect: {param: true}}, noise)
+    diag, _ = diagnose(meas, tables)
+    _check_found(diag, effect, param, true, meas, specimens, noise)
+
+
+@pytest.mark.parametrize("effect", ["thermal", "oldham_play", "fs_cup_torsion", "cs_housing",
+                                    pytest.param("tooth_friction", marks=pytest.mark.xfail(
+                                        strict=True, reason="flank friction changes the curve by "
+                                        "about 0.1 % of the signal in our 2D model: below 0.2 % noise"))])
+def test_effect_found_at_bench_noise(tmp_path, specimens, tables, signal, effect):
+    param, true = REALISTIC[effect]
+    noise = 0.002 * signal
+    meas = _measure(tmp_path, specimens, {effect: {param: true}}, noise)
+    diag, _ = diagnose(meas, tables)
+    _check_found(diag, effect, param, true, meas, specimens, noise)
+
+
+def test_no_hidden_effect_no_verdict(tmp_path, specimens, tables, signal):
+    """The baseline model itself plus noise: nothing may pay."""
+    meas = _measure(tmp_path, specimens, {}, 0.02 * signal)
+    diag, _ = diagnose(meas, tables)
+    assert diag["verdict"]["missing_effect"] is None, diag["verdict"]
+    assert diag["verdict"]["text"] == "no missing effect found"
+
+
+def test_elastic_effects_are_not_claimed_below_the_noise(tmp_path, specimens, tables, signal):
+    """Cup torsion at a realistic stiffness under 2 % noise changes the data by less than the
+    noise: the honest answer is no verdict, not a guess."""
+    param, true = REALISTIC["fs_cup_torsion"]
+    meas = _measure(tmp_path, specimens, {"fs_cup_torsion": {param: true}}, 0.02 * signal)
+    diag, _ = diagnose(meas, tables)
+    assert diag["verdict"]["missing_effect"] is None, diag["verdict"]
+
+
+def test_two_hidden_effects_found_in_two_rounds(tmp_path, specimens, tables, signal):
+    hidden = {"thermal": {"delta_T_K": 10.0}, "fs_cup_torsion": {"K_Nm_per_rad": 6.0e4}}
+    noise = 0.002 * signal
+    meas = _measure(tmp_path, specimens, hidden, noise)
+    diag, _ = diagnose(meas, tables)
+    found = diag["verdict"]["found_in_order"]
+    rounds = diag["rounds"]
+    assert len(found) == 2 and found[0] == "thermal", found
+    # the second round's winner is cup torsion or its look-alike, housing compliance
+    second = rounds[1]["verdict"]
+    assert "fs_cup_torsion" in [second["missing_effect"], *second["indistinguishable_from"]], second
+    final = diag["final"]["effects"]
+    assert final["thermal"]["delta_T_K"] == pytest.approx(10.0, rel=0.15)
+    # both switched on at their calibrated values, actual solves: the error is the noise
+    assert _rmse_switched_on(meas, specimens, final) <= 1.3 * noise
+
+
+def test_tables_key_every_variant(tables):
+    """Every planned variant solved for every specimen (one status per curve)."""
+    plan = [variant_key(v) for v in plan_variants({})]
+    assert set(tables["variant"]) == set(plan)
+    assert tables.groupby(["specimen_id", "variant"]).size().eq(21).all()

@@ -1,0 +1,13 @@
+"""Adapter for rule validation_diagnosis: calibrate and rank the candidate effects."""
+import logging, sys
+sys.path.insert(0, __import__("os").path.dirname(__file__))
+from _adapter import setup  # noqa: E402
+
+from hdwf.campaign import CampaignPlan  # noqa: E402
+from hdwf.diagnosis import diagnosis_stage  # noqa: E402
+
+prov = setup(snakemake)  # noqa: F821
+plan = CampaignPlan(**snakemake.params.plan)  # noqa: F821
+result = diagnosis_stage(snakemake.input.measurements, snakemake.input.tables, plan,  # noqa: F821
+                         snakemake.output.json, snakemake.output.points, prov)  # noqa: F821
+logging.info("verdict: %s", result["verdict"])
