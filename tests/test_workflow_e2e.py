@@ -85,3 +85,57 @@ def test_fe_study_chain_on_a_coarse_mesh(tmp_path):
     assert (ws / "results/fe/hd42/mesh/hd42-lhs-01.msh").stat().st_size > 0
     bench = (ws / "results/fe/hd42/benchmarks/solve_hd42-lhs-01.tsv").read_text().splitlines()
     assert bench[0].startswith("s\t") and len(bench) == 2
+
+
+@pytest.mark.e2e
+def test_validation_campaign_chain(tmp_path):
+    """A small campaign through diagnosis.json and the ladder: per-specimen jobs, a verdict,
+    the ladder falling; editing a measured value re-runs the diagnosis but no solve; a bad
+    measurement file stops the run naming file, row and field, and leaves results/ as it was."""
+    import json
+
+    import yaml
+
+    ws = _workspace(tmp_path)
+    demo = pd.read_csv(ws / "data/validation/demo_hd42.csv")
+    keep = sorted(demo["specimen_id"].unique())[:4]
+    demo[demo["specimen_id"].isin(keep)].to_csv(ws / "data/validation/tiny.csv", index=False)
+    config = yaml.safe_load((ws / "config.yaml").read_text())
+    config["validation"] = {"tiny": {"unit": "hd42", "measurements": "data/validation/tiny.csv",
+                                     "candidates": ["thermal", "oldham_play"], "rounds": 1,
+                                     "mesh": {"elements_over_height": 5, "elements_over_thickness": 3}}}
+    (ws / "config.yaml").write_text(yaml.safe_dump(config))
+    target = "results/validation/tiny/ladder.parquet"
+    run = subprocess.run([SNAKEMAKE, "--cores", "2", target], cwd=ws, capture_output=True, text=True, timeout=900)
+    assert run.returncode == 0, run.stderr[-3000:]
+    for sid in keep:   # one job per specimen, each with its table
+        assert (ws / f"results/validation/tiny/tables/{sid}.parquet").exists()
+    diag = json.loads((ws / "results/validation/tiny/diagnosis.json").read_text())
+    assert diag["verdict"]["missing_effect"] == "thermal"      # the demo data hide 12 K
+    assert diag["ranking"][0]["effect"] == "thermal" and diag["baseline"]["rmse_arcmin"] > 0.1
+    assert set(diag["ranking"][0]) >= {"effect", "params", "rmse_arcmin", "delta_bic"}
+    ladder = pd.read_parquet(ws / target)
+    assert list(ladder["model"]) == ["baseline", "with thermal"]
+    assert ladder["rmse_arcmin"].iloc[1] < 0.5 * ladder["rmse_arcmin"].iloc[0]
+
+    # a measured value changes: the diagnosis re-runs, the specimens' solves do not
+    data_file = ws / "data/validation/tiny.csv"
+    edited = pd.read_csv(data_file)
+    edited.loc[3, "twist_arcmin"] += 0.01
+    edited.to_csv(data_file, index=False)
+    dry = subprocess.run([SNAKEMAKE, "--cores", "2", target, "--dry-run"], cwd=ws, capture_output=True,
+                         text=True, timeout=120)
+    out = dry.stdout + dry.stderr
+    assert "validation_diagnosis" in out and "validation_specimen" not in out, out[-2000:]
+
+    # a bad measurement file: refused at start-up, nothing written
+    before = {p: p.read_bytes() for p in (ws / "results/validation").rglob("*") if p.is_file()}
+    bad = edited.copy()
+    bad["twist_arcmin"] = bad["twist_arcmin"].astype(object)
+    bad.loc[6, "twist_arcmin"] = "n/a"
+    bad.to_csv(data_file, index=False)
+    run = subprocess.run([SNAKEMAKE, "--cores", "2", target], cwd=ws, capture_output=True, text=True, timeout=120)
+    assert run.returncode != 0
+    assert "tiny.csv" in run.stderr and "row 7" in run.stderr  # row 1 = first data row and "twist_arcmin" in run.stderr, run.stderr[-2000:]
+    after = {p: p.read_bytes() for p in (ws / "results/validation").rglob("*") if p.is_file()}
+    assert after == before

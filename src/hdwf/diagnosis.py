@@ -367,7 +367,7 @@ def ladder_variants(diagnosis: dict) -> list[tuple[str, dict]]:
     cur = dict(fixed)
     for f in diagnosis["found"]:
         cur = {**cur, f["effect"]: f["params"]}
-        rungs.append((f"+ {f['effect']}", dict(cur)))
+        rungs.append(("with " + ", ".join(e for e in cur if e not in fixed), dict(cur)))
     return rungs
 
 

@@ -51,6 +51,13 @@ def full_report_inputs(wildcards):
                 files[f"{study}__{unit}__convergence"] = f"results/{study}/{unit}/convergence.parquet"
             if study == FE["picture"]["study"]:
                 files[f"{study}__{unit}__deformed_png"] = f"results/{study}/{unit}/deformed_{FE['picture']['design']}.png"
+    for c in CAMPAIGNS:
+        base = f"results/validation/{c}"
+        files.update({f"validation__{c}__diagnosis": f"{base}/diagnosis.json",
+                      f"validation__{c}__ladder": f"{base}/ladder.parquet",
+                      f"validation__{c}__measured_png": f"{base}/measured_vs_predicted.png",
+                      f"validation__{c}__residuals_png": f"{base}/residuals.png",
+                      f"validation__{c}__ladder_png": f"{base}/ladder.png"})
     return files
 
 
@@ -62,6 +69,7 @@ rule full_report:
     params:
         studies=STUDIES,
         fe_settings={k: v for k, v in FE.items() if k not in ("convergence", "picture")},
+        campaigns=list(CAMPAIGNS),
         data_dir=config["paper_data"],
         repo=REPO_DIR,
     log:

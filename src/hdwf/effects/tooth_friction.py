@@ -14,8 +14,8 @@ EFFECT = Effect(
         "it holds the teeth back, so the twist lags the torque. In the FE model every "
         "tooth contact gets a tangential force mu p against its slip (or, while it sticks, "
         "whatever tangential force keeps the slip at zero, up to mu p)."),
-    signature=("loading and unloading branches separate (a hysteresis loop that widens "
-               "with mu and the load); the lost motion itself changes little"),
+    signature=("loading and unloading branches separate (a hysteresis loop: the unloading "
+               "branch lags); the lost motion itself changes little"),
     parameters=(Parameter("mu", "–", 0.0, 0.3, 0.08,
                           "friction coefficient of steel on steel, lubricated", "linear", 3),),
     apply=lambda ch, mu: replace(ch, flank_friction=mu),

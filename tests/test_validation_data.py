@@ -1,0 +1,60 @@
+"""The shipped measurement files and the campaign settings of config.yaml."""
+
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import yaml
+
+from hdwf.config import validate_config
+from hdwf.errors import ConfigError
+from hdwf.measurements import load_measurements
+from hdwf.paper import load_fea_designs, paper_measurements
+
+from conftest import DATA, ROOT
+
+SCHEMA = ROOT / "workflow/schemas/config.schema.yaml"
+
+
+@pytest.mark.parametrize("unit", ["hd42", "hd120"])
+def test_paper_measurement_files_are_tables_4_and_5(unit):
+    """The paper campaign's 'measurements' are exactly the paper's FEA lost motion."""
+    shipped = load_measurements(ROOT / f"data/validation/paper_{unit}.csv")
+    assert shipped.form == "lost_motion"
+    table = load_fea_designs(DATA, unit)
+    assert list(shipped.specimens["specimen_id"]) == list(table["design_id"])
+    assert shipped.data["lost_motion_arcmin"].to_numpy() == pytest.approx(table["lost_motion_arcmin"].to_numpy(),
+                                                                          rel=1e-9)
+    assert paper_measurements(DATA, unit).shape == (27, 8)
+
+
+def test_demo_file_is_a_checked_curve_file():
+    demo = load_measurements(ROOT / "data/validation/demo_hd42.csv")
+    assert demo.form == "curve" and len(demo.specimens) == 16
+    assert (demo.data.groupby("specimen_id")["step"].count() == 21).all()
+
+
+def _config_with(campaign):
+    cfg = yaml.safe_load((ROOT / "config.yaml").read_text())
+    cfg["validation"] = {"c": campaign}
+    return cfg
+
+
+@pytest.mark.parametrize("campaign, field", [
+    ({"unit": "hd42", "measurements": "x.csv", "effects": {"warp": {"x": 1}}}, "validation.c.effects"),
+    ({"unit": "hd42", "measurements": "x.csv", "effects": {"thermal": {"dT": 1}}}, "validation.c.effects.thermal.dT"),
+    ({"unit": "hd42", "measurements": "x.csv", "effects": {"thermal": {"delta_T_K": 400}}},
+     "validation.c.effects.thermal.delta_T_K"),
+    ({"unit": "hd42", "measurements": "x.csv", "candidates": ["thermal", "nope"]}, "validation.c.candidates"),
+    ({"unit": "hd7", "measurements": "x.csv"}, "validation.c.unit"),
+])
+def test_bad_campaign_is_refused_naming_the_key(campaign, field):
+    with pytest.raises(ConfigError) as err:
+        validate_config(_config_with(campaign), SCHEMA)
+    assert f"field '{field}'" in str(err.value)
+
+
+def test_calibrate_is_accepted():
+    cfg = validate_config(_config_with({"unit": "hd42", "measurements": "x.csv",
+                                        "effects": {"tooth_friction": {"mu": "calibrate"}}}), SCHEMA)
+    assert cfg["validation"]["c"]["rounds"] == 2
