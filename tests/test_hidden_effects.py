@@ -145,6 +145,19 @@ def test_two_hidden_effects_found_in_two_rounds(tmp_path, specimens, tables, sig
     assert _rmse_switched_on(meas, specimens, final) <= 1.3 * noise
 
 
+def test_effect_switched_on_for_calibration_comes_first(tmp_path, specimens, tables, signal):
+    """``effects: {oldham_play: {play_arcsec: calibrate}}`` in a campaign: the effect is calibrated
+    before the search; the search then finds the hidden temperature difference on top of it."""
+    noise = 0.002 * signal
+    hidden = {"thermal": {"delta_T_K": 10.0}, "oldham_play": {"play_arcsec": 10.0}}
+    meas = _measure(tmp_path, specimens, hidden, noise)
+    diag, _ = diagnose(meas, tables, calibrate_first=["oldham_play"])
+    assert [f["effect"] for f in diag["found"]][0] == "oldham_play"
+    assert diag["verdict"]["found_in_order"][0] == "thermal"
+    assert diag["final"]["effects"]["oldham_play"]["play_arcsec"] == pytest.approx(10.0, rel=0.15)
+    assert diag["final"]["effects"]["thermal"]["delta_T_K"] == pytest.approx(10.0, rel=0.15)
+
+
 def test_tables_key_every_variant(tables):
     """Every planned variant solved for every specimen (one status per curve)."""
     plan = [variant_key(v) for v in plan_variants({})]

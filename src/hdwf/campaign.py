@@ -7,6 +7,9 @@ A *variant* is the baseline FE model with some effects switched on at given valu
 Reuse between candidates (what makes a campaign affordable):
 
 * one mesh per specimen, built once and shared by every variant of that specimen;
+* one assembly and factorisation of the bodies and one wave-generator stage per specimen:
+  every effect acts only once the teeth engage (``hdwf.fe.solve_lost_motion_variants``),
+  so each variant costs only its torque sequence (and the housing a new CS factorisation);
 * variants that differ only in effects acting in series at the output (``Effect.series``:
   cup torsion, Oldham play) share one contact solve: their twist is the solved rim twist
   plus the series element's, exactly;
@@ -91,18 +94,16 @@ def solve_variants(unit: str, params: dict[str, float], mesh, steps_per_ramp: in
     """Solve one specimen for every variant (one contact solve per distinct FE part).
 
     A variant whose solve fails gets ``status = "failed: <reason>"`` and NaN twists."""
-    from .fe import solve_lost_motion
+    from .fe import solve_lost_motion_variants
     from .fe_study import geometry_of
 
     geom = geometry_of(unit, params)
-    solved: dict[ModelChanges, object] = {}
+    changes = [model_changes(eff) for eff in variants]
+    parts = list(dict.fromkeys(ch.fe_part() for ch in changes))   # distinct, in order
+    solved = dict(zip(parts, solve_lost_motion_variants(geom, mesh, steps_per_ramp, parts)))
     frames = []
-    for eff in variants:
-        ch = model_changes(eff)
+    for eff, ch in zip(variants, changes):
         fe_part = ch.fe_part()
-        if fe_part not in solved:
-            solved[fe_part] = solve_lost_motion(geom, mesh, steps_per_ramp=steps_per_ramp,
-                                                changes=fe_part)
         res = solved[fe_part]
         ok = res.status == "ok"
         if ok:
@@ -232,7 +233,8 @@ def campaign_plan(name: str, camp: dict, fe: dict) -> CampaignPlan:
                 "refinement": mesh.get("refinement", fe["refinement"]),
                 "symmetry": fe.get("symmetry", "full")}
     return CampaignPlan(name, camp["unit"], camp["measurements"], fixed, calib, cands,
-                        int(camp.get("rounds", 2)), settings, int(fe["steps_per_ramp"]))
+                        int(camp.get("rounds", 2)), settings,
+                        int(camp.get("steps_per_ramp", fe["steps_per_ramp"])))
 
 
 def specimen_stage(unit: str, specimen: dict, settings: dict, steps_per_ramp: int, variants: list[dict],

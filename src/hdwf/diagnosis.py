@@ -77,8 +77,14 @@ def predict(table: pd.DataFrame, obs: pd.DataFrame, variant: str) -> np.ndarray:
             raise KeyError(f"specimen {sid!r} has no solve for variant {variant!r}")
         tw = g["twist_arcmin"].to_numpy(float)
         T = g["torque_Nm"].to_numpy(float)
+        if not np.isfinite(tw).all():        # this variant's solve failed for this specimen
+            continue
         if q == "twist":
-            out[i] = tw[g["step"].to_numpy() == obs["step"].iloc[i]][0]
+            hit = tw[g["step"].to_numpy() == obs["step"].iloc[i]]
+            if hit.size == 0:
+                raise ValueError(f"specimen {sid!r}: measured step {obs['step'].iloc[i]} is not a step of the "
+                                 f"model's test ({len(tw)} steps); set the campaign's steps_per_ramp to match")
+            out[i] = hit[0]
         else:
             kp, km = int(np.nanargmax(T)), int(np.nanargmin(T))
             phi_p, phi_m = tw[kp], -tw[km]
@@ -337,6 +343,7 @@ def diagnose(meas, table: pd.DataFrame, fixed: dict | None = None, calibrate_fir
                   "rmse_over_noise": (final_rmse / noise) if noise else None},
         "notes": notes,
         "worst_specimens": per.head(5).to_dict(orient="records"),
+        "per_specimen": per.to_dict(orient="records"),
         "residual_tests": tests.to_dict(orient="records"),
     }
     return result, points

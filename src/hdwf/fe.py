@@ -531,13 +531,6 @@ class LostMotionModel:
         # of the rim) is the same for the half and the whole
         self.f_scale = 0.5 if self.half else 1.0
         bms = dict(mesh.bodies)
-        if changes.cs_scale != 1.0:     # thermal strain of the CS relative to the rest
-            cs0 = bms["cs"]
-            from skfem import MeshTri
-            bms["cs"] = BodyMesh(name=cs0.name, mesh=MeshTri(cs0.mesh.p * changes.cs_scale,
-                                                              cs0.mesh.t),
-                                 thickness=cs0.thickness, node_sets=cs0.node_sets,
-                                 edge_sets=cs0.edge_sets)
         # watch sets: every contact node (teeth only in the engagement zones)
         def zone(bm, nodes):
             th = np.arctan2(bm.mesh.p[1, nodes], bm.mesh.p[0, nodes])
@@ -550,16 +543,14 @@ class LostMotionModel:
         or_w = np.concatenate([bms["or"].node_sets["or_race"], bms["or"].node_sets["or_outer"]])
         self.factorize_s = 0.0
         self.bodies: dict[str, _Body] = {}
-        cs_springs = None
-        if math.isfinite(changes.cs_rim_stiffness_N_mm2):
-            cs_springs = changes.cs_rim_stiffness_N_mm2 * _boundary_lengths(
-                bms["cs"].mesh, bms["cs"].edge_sets["cs_outer"])
+        self._cs_mesh0, self._cs_watch = bms["cs"], cs_w
         for name, w, fixed in (("fs", fs_w, None),
                                ("cs", cs_w, bms["cs"].node_sets["cs_outer"]),
                                ("ir", ir_w, None), ("or", or_w, None)):
-            springs = cs_springs if name == "cs" else None
-            b, tf = _make_body(name, bms[name], self.E, geom.nu, fixed, w, self.half,
-                               ground_springs=springs)
+            if name == "cs":
+                b, tf = self._build_cs(changes)
+            else:
+                b, tf = _make_body(name, bms[name], self.E, geom.nu, fixed, w, self.half)
             self.factorize_s += tf
             self.bodies[name] = b
         ofs = 0
@@ -607,6 +598,56 @@ class LostMotionModel:
         self.CWYY = np.zeros((0, 0))                     # Gt_W K^-1 Gt_W^T
         self._TW = None
         self._sigma: dict[tuple[str, int], float] = {}   # friction direction per pair
+
+    def _build_cs(self, changes: ModelChanges) -> tuple[_Body, float]:
+        """The CS body: scaled (thermal strain) and on rim springs (housing) as ``changes`` say."""
+        bm = self._cs_mesh0
+        if changes.cs_scale != 1.0:
+            from skfem import MeshTri
+            bm = BodyMesh(name=bm.name, mesh=MeshTri(bm.mesh.p * changes.cs_scale, bm.mesh.t),
+                          thickness=bm.thickness, node_sets=bm.node_sets, edge_sets=bm.edge_sets)
+        springs = None
+        if math.isfinite(changes.cs_rim_stiffness_N_mm2):
+            springs = changes.cs_rim_stiffness_N_mm2 * _boundary_lengths(bm.mesh,
+                                                                         bm.edge_sets["cs_outer"])
+        return _make_body("cs", bm, self.E, self.g.nu, bm.node_sets["cs_outer"], self._cs_watch,
+                          self.half, ground_springs=springs)
+
+    def fork(self) -> "LostMotionModel":
+        """A copy that shares the factorised bodies and copies the mutable contact state."""
+        import copy
+
+        new = copy.copy(self)
+        new.bodies, new.rows = dict(self.bodies), dict(self.rows)
+        new.W, new.Wpos = list(self.W), dict(self.Wpos)
+        new.mode_list, new._sigma = list(self.mode_list), dict(self._sigma)
+        for name in ("_Xbuf", "_Ybuf", "Xq", "Yq", "CW", "CWY", "CWYY"):
+            setattr(new, name, getattr(self, name).copy())
+        return new
+
+    def apply_tooth_stage_changes(self, changes: ModelChanges):
+        """Switch the tooth-stage changes (friction, CS scale and support) on a model whose
+        wave generator is mounted: none of them touches the bodies or contacts of that stage
+        (the CS has no contact before the teeth), so it is reused as it is."""
+        if any(k == "tooth" for k, _ in self.W):
+            raise RuntimeError("apply_tooth_stage_changes: the teeth are already engaged")
+        old = self.changes
+        if (changes.cs_scale, changes.cs_rim_stiffness_N_mm2) != (old.cs_scale,
+                                                                   old.cs_rim_stiffness_N_mm2):
+            prev = self.bodies["cs"]
+            b, tf = self._build_cs(changes)
+            b.wofs, b.wpos = prev.wofs, prev.wpos
+            self.bodies["cs"] = b
+            self.factorize_s += tf
+        self.mu = float(changes.flank_friction)
+        if self.mu > 0 and self.CWY.shape[0] != len(self.W):
+            n = len(self.W)      # the mounted contacts have no slip rows: zero columns
+            self._Ybuf = np.zeros((self.nwatch, max(n, 1)))
+            self.Yq = np.zeros(n)
+            self.CWY = np.zeros((n, n))
+            self.CWYY = np.zeros((n, n))
+            self._TW = sp.csr_matrix((n, self.nwatch))
+        self.changes = changes
 
     # ---------------------------------------------------------------- linear algebra
     def _solve_body(self, b: _Body, F: np.ndarray) -> np.ndarray:
@@ -1148,6 +1189,125 @@ def _load_path(steps_per_ramp: int) -> np.ndarray:
     return np.concatenate([up, up[::-1][1:], -up[1:], -up[::-1][1:]])
 
 
+def _mount_wave_generator(model: LostMotionModel, geom: DriveGeometry):
+    """Stage 1: the wave generator pushed into the FS (no teeth), FS rotation pinned.
+    Returns (u_wg, state, wg deflection in um)."""
+    # (the half model's symmetric field has no translations: no modes in stage 1)
+    model.mode_list = [] if model.half else [("fs", "tx"), ("fs", "ty"), ("ir", "tx"),
+                                             ("ir", "ty"), ("or", "tx"), ("or", "ty")]
+    model.rows["ball"] = model.ball_rows()
+    model.rows["fit"] = model.fit_rows()
+    u = np.zeros(model.nwatch)
+    model.rows["cam"] = model.cam_rows(u)
+    state = None
+    for geo_it in range(6):
+        state = model.solve_level(0.0, state["active"] if state else None)
+        u = state["u"]
+        new = model.cam_rows(u)
+        change = np.max(np.abs((new.g0 + new.G @ u) - (model.rows["cam"].g0
+                                                        + model.rows["cam"].G @ u)))
+        if change < 1e-6 and geo_it > 0:
+            break
+        model._replace_rows("cam", new)
+    fs = model.bodies["fs"]
+    bore = fs.bm.node_sets["fs_bore"]
+    j0 = bore[np.argmin((fs.x[0, bore] - geom.r_fs_bore) ** 2 + fs.x[1, bore] ** 2)]
+    return u, state, float(u[fs.wpos[0, j0]]) * 1000.0
+
+
+def _torque_test(model: LostMotionModel, geom: DriveGeometry, frac: np.ndarray, u_wg, state,
+                 fields: dict | None):
+    """Stage 2: teeth at the deflected configuration, FS rotation free, the torque sequence.
+    Returns (rim twists in rad, max penetration, re-detected penetration, teeth in contact)."""
+    Tn = geom.torque
+    cand = 0.25 * geom.module + 3 * (geom.r_fs + geom.r_cs)
+    model.rows["tooth"] = model.tooth_rows(u_wg, cand)
+    model.mode_list = model.mode_list + [("fs", "rot")]
+    active = state["active"]
+    twists, maxpen, maxpen_nl, tooth_count = [], 0.0, 0.0, 0
+    last_sign = 1.0
+    for k, fr in enumerate(frac):
+        if abs(fr) > 1e-12:
+            last_sign = math.copysign(1.0, fr)
+            T = fr * Tn
+        else:
+            T = ZERO_TORQUE_BIAS * Tn * last_sign
+        st = model.solve_level(T, active)
+        if abs(abs(fr) - 1.0) < 1e-12:
+            # independent check at +-T: re-detect every FS/CS pair in the zones at the
+            # deformed configuration (nonlinear gap, no candidate threshold).  Large
+            # twists slide the flanks along each other; if the linearised pairing
+            # then misses more than RELIN_TOL, re-pair and re-linearise the tooth
+            # rows about this state and solve the level again.
+            for relin in range(4):
+                chk = model.tooth_rows(st["u"], np.inf)
+                pen_nl = float(-(chk.g0 + chk.G @ st["u"]).min())
+                if pen_nl <= RELIN_TOL or relin == 3:
+                    break
+                tr = model.rows["tooth"]
+                new = model.tooth_rows(st["u"], np.inf, nodes=tr.info["nodes"])
+                # only pairs at or near contact are re-linearised; the open flanks
+                # keep the WG-state pairing, which is the right one for the way back
+                near = (tr.g0 + tr.G @ st["u"]) < RELIN_NEAR
+                Dn = sp.diags(near.astype(float))
+                Df = sp.diags((~near).astype(float))
+                info = dict(tr.info, Gt=(Dn @ new.info["Gt"] + Df @ tr.info["Gt"]).tocsr())
+                mixed = _Rows("tooth", (Dn @ new.G + Df @ tr.G).tocsr(),
+                              np.where(near, new.g0, tr.g0), info)
+                model._replace_rows("tooth", mixed)
+                st = model.solve_level(T, st["active"])
+            maxpen_nl = max(maxpen_nl, pen_nl)
+        active = st["active"]
+        twists.append(st["twist"])
+        kinds = np.array([i[0] for i in st["ids"]])
+        geo_mask = kinds != "ball"
+        maxpen = max(maxpen, float(-(st["gap"][geo_mask]).min()))
+        if abs(fr - 1.0) < 1e-12:
+            if fields is not None and "plus" not in fields:
+                fields["plus"] = model.full_displacements(st, T)
+            tr = model.rows["tooth"]
+            ti = [i for (kk, i) in st["ids"] if kk == "tooth"]
+            pt = st["p"][kinds == "tooth"]
+            tooth_count = int(np.unique(tr.info["tooth"][np.array(ti)[pt > 0]]).size)
+            if model.half:
+                tooth_count *= 2             # every tooth has its image at +pi
+    return np.array(twists), maxpen, maxpen_nl, tooth_count
+
+
+def _result(geom, frac, changes, twists, maxpen, maxpen_nl, tooth_count, model, t0, wg_defl,
+            fields) -> LostMotionResult:
+    Tn = geom.torque
+    tw = series_output_twist(twists, frac * Tn, changes) / ARCMIN
+    tw = tw - tw[0]
+    kp = int(np.argmin(np.abs(frac - 1.0)))
+    km = int(np.argmin(np.abs(frac + 1.0)))
+    phi_p, phi_m = float(tw[kp]), float(-tw[km])
+    return LostMotionResult(
+        phi_plus_arcmin=phi_p, phi_minus_arcmin=phi_m,
+        lost_motion_arcmin=phi_p + phi_m, step=np.arange(frac.size),
+        torque_Nm=frac * Tn / 1000.0, twist_arcmin=tw, teeth_in_contact=tooth_count,
+        max_penetration_um=max(0.0, maxpen) * 1000.0, iterations=model.iterations,
+        status="ok", reason="", solve_s=time.perf_counter() - t0,
+        factorize_s=model.factorize_s, n_dofs=model.n_dofs, wg_deflection_um=wg_defl,
+        max_penetration_redetected_um=max(0.0, maxpen_nl) * 1000.0,
+        notes=(f"zero-torque steps at {ZERO_TORQUE_BIAS:g} T_test towards the last load; "
+               f"tooth penetration re-detected at the deformed state at +-T: "
+               f"{max(0.0, maxpen_nl) * 1000:.4f} um"),
+        fields=fields)
+
+
+def _failed(exc, model, t0) -> LostMotionResult:
+    nan, empty = float("nan"), np.array([])
+    return LostMotionResult(
+        phi_plus_arcmin=nan, phi_minus_arcmin=nan, lost_motion_arcmin=nan,
+        step=empty, torque_Nm=empty, twist_arcmin=empty, teeth_in_contact=0,
+        max_penetration_um=nan, iterations=model.iterations if model else 0,
+        status="failed", reason=f"{type(exc).__name__}: {exc}",
+        solve_s=time.perf_counter() - t0,
+        factorize_s=model.factorize_s if model else nan,
+        n_dofs=model.n_dofs if model else 0)
+
+
 def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int = 5,
                       E: float | None = None, max_iter: int = 200,
                       tol_gap: float = TOL_GAP, keep_fields: bool = False,
@@ -1163,112 +1323,43 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
     changes = ModelChanges() if changes is None else changes
     t0 = time.perf_counter()
     frac = _load_path(steps_per_ramp)
-    Tn = geom.torque
-    nan = float("nan")
-    empty = np.array([])
     model = None
     try:
         model = LostMotionModel(geom, mesh, E=E, max_iter=max_iter, tol_gap=tol_gap,
                                 changes=changes)
-        # ---- stage 1: wave generator (no teeth), FS rotation pinned
-        # (the half model's symmetric field has no translations: no modes in stage 1)
-        model.mode_list = [] if model.half else [("fs", "tx"), ("fs", "ty"), ("ir", "tx"),
-                                                 ("ir", "ty"), ("or", "tx"), ("or", "ty")]
-        model.rows["ball"] = model.ball_rows()
-        model.rows["fit"] = model.fit_rows()
-        u = np.zeros(model.nwatch)
-        model.rows["cam"] = model.cam_rows(u)
-        state = None
-        for geo_it in range(6):
-            state = model.solve_level(0.0, state["active"] if state else None)
-            u = state["u"]
-            new = model.cam_rows(u)
-            change = np.max(np.abs((new.g0 + new.G @ u) - (model.rows["cam"].g0
-                                                            + model.rows["cam"].G @ u)))
-            if change < 1e-6 and geo_it > 0:
-                break
-            model._replace_rows("cam", new)
-        u_wg = u
+        u_wg, state, wg_defl = _mount_wave_generator(model, geom)
         fields = {"wg": model.full_displacements(state, 0.0)} if keep_fields else None
-        fs = model.bodies["fs"]
-        bore = fs.bm.node_sets["fs_bore"]
-        j0 = bore[np.argmin((fs.x[0, bore] - geom.r_fs_bore) ** 2 + fs.x[1, bore] ** 2)]
-        wg_defl = float(u_wg[fs.wpos[0, j0]]) * 1000.0
-        # ---- stage 2: teeth at the deflected configuration, FS rotation free
-        cand = 0.25 * geom.module + 3 * (geom.r_fs + geom.r_cs)
-        model.rows["tooth"] = model.tooth_rows(u_wg, cand)
-        model.mode_list = model.mode_list + [("fs", "rot")]
-        active = state["active"]
-        twists, maxpen, maxpen_nl, tooth_count = [], 0.0, 0.0, 0
-        last_sign = 1.0
-        for k, fr in enumerate(frac):
-            if abs(fr) > 1e-12:
-                last_sign = math.copysign(1.0, fr)
-                T = fr * Tn
-            else:
-                T = ZERO_TORQUE_BIAS * Tn * last_sign
-            st = model.solve_level(T, active)
-            if abs(abs(fr) - 1.0) < 1e-12:
-                # independent check at +-T: re-detect every FS/CS pair in the zones at the
-                # deformed configuration (nonlinear gap, no candidate threshold).  Large
-                # twists slide the flanks along each other; if the linearised pairing
-                # then misses more than RELIN_TOL, re-pair and re-linearise the tooth
-                # rows about this state and solve the level again.
-                for relin in range(4):
-                    chk = model.tooth_rows(st["u"], np.inf)
-                    pen_nl = float(-(chk.g0 + chk.G @ st["u"]).min())
-                    if pen_nl <= RELIN_TOL or relin == 3:
-                        break
-                    tr = model.rows["tooth"]
-                    new = model.tooth_rows(st["u"], np.inf, nodes=tr.info["nodes"])
-                    # only pairs at or near contact are re-linearised; the open flanks
-                    # keep the WG-state pairing, which is the right one for the way back
-                    near = (tr.g0 + tr.G @ st["u"]) < RELIN_NEAR
-                    Dn = sp.diags(near.astype(float))
-                    Df = sp.diags((~near).astype(float))
-                    info = dict(tr.info, Gt=(Dn @ new.info["Gt"] + Df @ tr.info["Gt"]).tocsr())
-                    mixed = _Rows("tooth", (Dn @ new.G + Df @ tr.G).tocsr(),
-                                  np.where(near, new.g0, tr.g0), info)
-                    model._replace_rows("tooth", mixed)
-                    st = model.solve_level(T, st["active"])
-                maxpen_nl = max(maxpen_nl, pen_nl)
-            active = st["active"]
-            twists.append(st["twist"])
-            kinds = np.array([i[0] for i in st["ids"]])
-            geo_mask = kinds != "ball"
-            maxpen = max(maxpen, float(-(st["gap"][geo_mask]).min()))
-            if abs(fr - 1.0) < 1e-12:
-                if keep_fields and "plus" not in fields:
-                    fields["plus"] = model.full_displacements(st, T)
-                tr = model.rows["tooth"]
-                ti = [i for (kk, i) in st["ids"] if kk == "tooth"]
-                pt = st["p"][kinds == "tooth"]
-                tooth_count = int(np.unique(tr.info["tooth"][np.array(ti)[pt > 0]]).size)
-                if model.half:
-                    tooth_count *= 2             # every tooth has its image at +pi
-        tw = series_output_twist(np.array(twists), frac * Tn, changes) / ARCMIN
-        tw = tw - tw[0]
-        kp = int(np.argmin(np.abs(frac - 1.0)))
-        km = int(np.argmin(np.abs(frac + 1.0)))
-        phi_p, phi_m = float(tw[kp]), float(-tw[km])
-        return LostMotionResult(
-            phi_plus_arcmin=phi_p, phi_minus_arcmin=phi_m,
-            lost_motion_arcmin=phi_p + phi_m, step=np.arange(frac.size),
-            torque_Nm=frac * Tn / 1000.0, twist_arcmin=tw, teeth_in_contact=tooth_count,
-            max_penetration_um=max(0.0, maxpen) * 1000.0, iterations=model.iterations,
-            status="ok", reason="", solve_s=time.perf_counter() - t0,
-            factorize_s=model.factorize_s, n_dofs=model.n_dofs, wg_deflection_um=wg_defl,
-            max_penetration_redetected_um=max(0.0, maxpen_nl) * 1000.0,
-            notes=(f"zero-torque steps at {ZERO_TORQUE_BIAS:g} T_test towards the last load; "
-                   f"tooth penetration re-detected at the deformed state at +-T: "
-                   f"{max(0.0, maxpen_nl) * 1000:.4f} um"),
-            fields=fields)
+        out = _torque_test(model, geom, frac, u_wg, state, fields)
+        return _result(geom, frac, changes, *out, model, t0, wg_defl, fields)
     except Exception as exc:   # any failure is reported, never a silent number
-        return LostMotionResult(
-            phi_plus_arcmin=nan, phi_minus_arcmin=nan, lost_motion_arcmin=nan,
-            step=empty, torque_Nm=empty, twist_arcmin=empty, teeth_in_contact=0,
-            max_penetration_um=nan, iterations=model.iterations if model else 0,
-            status="failed", reason=f"{type(exc).__name__}: {exc}",
-            solve_s=time.perf_counter() - t0,
-            factorize_s=model.factorize_s if model else nan,
-            n_dofs=model.n_dofs if model else 0)
+        return _failed(exc, model, t0)
+
+
+def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int,
+                               variants: list[ModelChanges]) -> list[LostMotionResult]:
+    """The test for several model variants of one design, sharing what they can: the bodies
+    are assembled and factorised and the wave generator mounted once; each variant then
+    switches its tooth-stage changes on a copy (a new CS factorisation only when it changes
+    the CS support) and runs the torque sequence. Same numbers as ``solve_lost_motion``
+    for each variant up to round-off."""
+    t0 = time.perf_counter()
+    frac = _load_path(steps_per_ramp)
+    base = None
+    try:
+        base = LostMotionModel(geom, mesh)
+        u_wg, state, wg_defl = _mount_wave_generator(base, geom)
+    except Exception as exc:
+        failed = _failed(exc, base, t0)
+        return [failed for _ in variants]
+    out = []
+    for ch in variants:
+        t1 = time.perf_counter()
+        model = None
+        try:
+            model = base.fork()
+            model.apply_tooth_stage_changes(ch.fe_part())
+            res = _torque_test(model, geom, frac, u_wg, state, None)
+            out.append(_result(geom, frac, ch, *res, model, t1, wg_defl, None))
+        except Exception as exc:
+            out.append(_failed(exc, model, t1))
+    return out
