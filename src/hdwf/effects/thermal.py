@@ -18,7 +18,7 @@ EFFECT = Effect(
     signature="the dead band shrinks (dT > 0) or grows (dT < 0); the elastic slopes stay",
     parameters=(Parameter("delta_T_K", "K", -40.0, 40.0, 10.0,
                           "temperature of FS and wave generator minus that of the CS",
-                          "linear", 4),),
+                          "linear", 8),),   # every 10 K: the response bends where teeth engage
     apply=lambda ch, delta_T_K: replace(ch, cs_scale=ch.cs_scale / (1.0 + ALPHA_STEEL * delta_T_K)),
     references="about 0.085 um of flank clearance per K for HD 42 (background)",
     off={"delta_T_K": 0.0},
