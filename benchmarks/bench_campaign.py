@@ -21,16 +21,15 @@ from pathlib import Path
 import pandas as pd
 import yaml
 
-ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _workspace import ROOT, copy_workflow  # noqa: E402
 BIN = Path(sys.executable).parent
 
 
 def one_run(data: Path, n: int) -> tuple[float, dict, list[float]]:
     with tempfile.TemporaryDirectory(prefix="hdwf-bench-") as tmp:
         tmp = Path(tmp)
-        for item in ("Snakefile", "config.yaml", "workflow", "data"):
-            src = ROOT / item
-            (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp / item)
+        copy_workflow(tmp)
         shutil.copy(data, tmp / "data/validation/bench.csv")
         cfg = yaml.safe_load((tmp / "config.yaml").read_text())
         cfg["validation"] = {"bench": {"unit": "hd42", "measurements": "data/validation/bench.csv"}}

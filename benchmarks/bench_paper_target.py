@@ -5,7 +5,6 @@ Usage: .venv/bin/python benchmarks/bench_paper_target.py [--runs 3]
 """
 
 import argparse
-import shutil
 import statistics
 import subprocess
 import sys
@@ -13,15 +12,14 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _workspace import copy_workflow  # noqa: E402
 
 
 def one_run() -> float:
     with tempfile.TemporaryDirectory(prefix="hdwf-bench-") as tmp:
         tmp = Path(tmp)
-        for item in ("Snakefile", "config.yaml", "workflow", "data"):
-            src = ROOT / item
-            (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp / item)
+        copy_workflow(tmp)
         snakemake = str(Path(sys.executable).with_name("snakemake"))
         t0 = time.perf_counter()
         subprocess.run([snakemake, "--cores", "2", "paper", "--quiet"], cwd=tmp, check=True,

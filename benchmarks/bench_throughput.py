@@ -7,7 +7,6 @@ Usage: .venv/bin/python benchmarks/bench_throughput.py [--designs 6] [--repeats 
 """
 
 import argparse
-import shutil
 import statistics
 import subprocess
 import sys
@@ -15,7 +14,8 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _workspace import copy_workflow  # noqa: E402
 SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))
 
 
@@ -26,9 +26,7 @@ def main():
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="hdwf-bench-") as tmp:
         tmp = Path(tmp)
-        for item in ("Snakefile", "config.yaml", "workflow", "data"):
-            src = ROOT / item
-            (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp / item)
+        copy_workflow(tmp)
         targets = [f"results/fe_at_paper/hd42/designs/paper-{i:02d}.parquet" for i in range(1, args.designs + 1)]
         meshes = [t.replace("/designs/", "/mesh/").replace(".parquet", ".npz") for t in targets]
         subprocess.run([SNAKEMAKE, *meshes, "--cores", "2", "--quiet"], cwd=tmp, check=True)
