@@ -35,8 +35,9 @@ def one_run(data: Path, n: int) -> tuple[float, dict, list[float]]:
         cfg["validation"] = {"bench": {"unit": "hd42", "measurements": "data/validation/bench.csv"}}
         (tmp / "config.yaml").write_text(yaml.safe_dump(cfg))
         t0 = time.perf_counter()
-        subprocess.run([str(BIN / "snakemake"), "--cores", "2", "--quiet",
-                        "results/validation/bench/diagnosis.json", "results/validation/bench/ladder.parquet"],
+        subprocess.run([str(BIN / "snakemake"), "--cores", "2",
+                        "results/validation/bench/diagnosis.json", "results/validation/bench/ladder.parquet",
+                        "--quiet"],
                        cwd=tmp, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         wall = time.perf_counter() - t0
         diag = json.loads((tmp / "results/validation/bench/diagnosis.json").read_text())

@@ -193,7 +193,8 @@ def measured_vs_predicted_figure(points: pd.DataFrame, title: str, path) -> None
     """Measured against predicted, before (campaign model) and after (found effects on)."""
     fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), sharex=True, sharey=True)
     D = points["D"].to_numpy(float)
-    lo, hi = np.nanmin(D), np.nanmax(D)
+    every = np.concatenate([D, points["S_model"].to_numpy(float), points["S_final"].to_numpy(float)])
+    lo, hi = np.nanmin(every), np.nanmax(every)
     pad = 0.05 * (hi - lo or 1.0)
     for ax, col, name in zip(axes, ("S_model", "S_final"), ("campaign model", "with the found effects")):
         S = points[col].to_numpy(float)
