@@ -43,7 +43,7 @@ def test_registry_has_five_documented_effects():
         assert eff.description and eff.signature and eff.parameters
         for p in eff.parameters:
             assert p.lower <= p.realistic <= p.upper and p.unit
-            # switching the effect off leaves the model exactly as it was
+        # at a realistic value the effect changes the model
         assert model_changes({eff.name: {p.name: p.realistic for p in eff.parameters}}) != ModelChanges()
 
 

@@ -49,17 +49,6 @@ def variant_key(effects: dict[str, dict[str, float]]) -> str:
     return "+".join(parts)
 
 
-def parse_variant_key(key: str) -> dict[str, dict[str, float]]:
-    if key == BASELINE:
-        return {}
-    out: dict[str, dict[str, float]] = {}
-    for part in key.split("+"):
-        name, rest = part.split(":", 1)
-        p, v = rest.split("=", 1)
-        out.setdefault(name, {})[p] = float(v)
-    return out
-
-
 def candidate_names(fixed: dict | None = None) -> list[str]:
     """Every registered effect that is not already part of the campaign's model."""
     return [n for n in registry() if n not in (fixed or {})]

@@ -32,7 +32,7 @@ import pandas as pd
 from scipy.interpolate import make_interp_spline
 from scipy.optimize import least_squares
 
-from .campaign import BASELINE, parse_variant_key, variant_key
+from .campaign import variant_key
 from .effects import get as get_effect
 from .validation import Candidate, bic, comparison_points, residual_tests, summarise, verdict
 
@@ -104,13 +104,11 @@ class Response:
     def __post_init__(self):
         k = min(3, len(self.t) - 1)
         self._spline = make_interp_spline(self.t, self.S, k=k, axis=0)
-
-    def at(self, t: float) -> np.ndarray:
-        return self._spline(float(t))
+        self._off = self.S[int(np.argmin(np.abs(self.t)))]   # the tabulated "off" row (t = 0)
 
     def change(self, t: float) -> np.ndarray:
         """Prediction at t minus the prediction with the effect off."""
-        return self._spline(float(t)) - self._spline(0.0)
+        return self._spline(float(t)) - self._off
 
     def value(self, t: float) -> float:
         return get_effect(self.effect).param(self.param).from_t(t)
@@ -399,7 +397,7 @@ def ladder_table(meas, table: pd.DataFrame, diagnosis: dict) -> pd.DataFrame:
 
 
 __all__ = ["diagnose", "ladder_table", "ladder_variants", "calibrate", "observation_frame", "predict",
-           "responses", "BASELINE", "parse_variant_key"]
+           "responses"]
 
 
 def json_safe(obj):

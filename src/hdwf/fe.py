@@ -88,14 +88,15 @@ Approximations (known, small): P1 triangles (Phi of the designs we checked moves
 < 2 % between 1x and 1.25x the paper's density, see docs/fe-model.md); the fit bins compare the
 two surfaces at equal reference angles (their relative slide of ~10 um on a surface slope
 <= 0.017 shifts those gaps by < 0.2 um, the same for every design); ball 0 sits on the
-major axis (one sample of the WG angle); no friction, no cup torsion (see background).
+major axis (one sample of the WG angle).  Friction, cup torsion, housing compliance,
+a temperature difference and Oldham play are off in the baseline (``ModelChanges``).
 """
 
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -126,9 +127,9 @@ class ModelChanges:
     ``hdwf.effects`` maps each candidate effect's parameters onto these; every field is a
     change to the FE model itself:
 
-    * ``flank_friction``: Coulomb coefficient on the FS-CS tooth contacts.  Each contact
-      force becomes p (n + mu sigma t), sigma = -sign of the flank slip over the load
-      step (sliding), or the value in [-1, 1] that makes the slip vanish (sticking).
+    * ``flank_friction``: Coulomb coefficient on the FS-CS tooth contacts.  A sliding pair's
+      force becomes p (n + mu sigma t), sigma = -sign of its slip over the load step; a
+      sticking pair carries an unknown tangential force (|f_t| <= mu p) and does not slip.
     * ``cs_rim_stiffness_N_mm2``: the CS outer rim held by radial and tangential springs
       of this stiffness per mm of rim (an elastic housing) instead of clamped (inf).
     * ``cs_scale``: the CS mesh scaled about the axis by this factor, i.e. a uniform
@@ -146,8 +147,8 @@ class ModelChanges:
     output_play_rad: float = 0.0
 
     def fe_part(self) -> "ModelChanges":
-        """The changes that need a new contact solve (the series elements do not)."""
-        return ModelChanges(self.flank_friction, self.cs_rim_stiffness_N_mm2, self.cs_scale)
+        """The changes that need a new contact solve: all but the series elements."""
+        return replace(self, output_compliance_rad_per_Nmm=0.0, output_play_rad=0.0)
 
 
 # --------------------------------------------------------------------------------------
@@ -632,6 +633,11 @@ class LostMotionModel:
         if any(k == "tooth" for k, _ in self.W):
             raise RuntimeError("apply_tooth_stage_changes: the teeth are already engaged")
         old = self.changes
+        handled = {"flank_friction", "cs_rim_stiffness_N_mm2", "cs_scale"}
+        other = [f.name for f in fields(ModelChanges) if f.name not in handled
+                 and getattr(changes, f.name) != getattr(ModelChanges(), f.name)]
+        if other:    # a new tooth-stage change must be applied here too (adding-an-effect.md)
+            raise NotImplementedError(f"apply_tooth_stage_changes does not apply {other}")
         if (changes.cs_scale, changes.cs_rim_stiffness_N_mm2) != (old.cs_scale,
                                                                    old.cs_rim_stiffness_N_mm2):
             prev = self.bodies["cs"]
@@ -966,10 +972,10 @@ class LostMotionModel:
         """Solve the contact problem at torque T (N mm), warm-started from ``active``
         (and the last displacement); Hertz secants of the balls iterated to 0.1 %.
 
-        With flank friction the slip direction of every tooth pair over this load step is
-        iterated too: sigma = -sign(slip) for sliding pairs; a pair whose slip changes
-        sign with sigma is sticking, and its sigma in [-1, 1] is found by the secant rule
-        on slip = 0 (the tangential force inside the friction cone)."""
+        With flank friction the stick/slip state of every loaded tooth pair is iterated
+        too: a pair coming into contact slides against its slip; a sticking pair whose
+        tangential force leaves the cone |f_t| <= mu p slides in the force's direction; a
+        sliding pair whose slip runs with its friction force sticks."""
         G, g0, ids = self._all_rows()
         R, Rq, Rf = self._R()
         GR = G @ R
