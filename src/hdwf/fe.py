@@ -31,8 +31,12 @@ Contacts (unilateral, frictionless), rows of a gap operator g = g0 + G u >= 0:
   Both arc rows integrate the field along the boundary edges instead of averaging the
   nodes that fall inside: node-count averages made the WG stiffness, and so Phi of HD 42,
   jump by up to 4 % from one mesh to the next;
-* FS - CS flanks: node-to-segment (FS flank/tip nodes against CS boundary segments),
-  built at the wave-generator-deflected configuration (gaps evaluated at the deformed FS)
+* FS - CS flanks: node-to-segment in two passes (FS flank/tip nodes against CS boundary
+  segments; CS tip-land and tip-corner nodes against FS boundary segments), a node beyond
+  the end of its closest segment measuring its distance to that corner (otherwise FS flank
+  nodes below a CS tip land "touched" it along the land's normal: a false contact that
+  came and went with the node spacing and moved Phi of hd42-lhs-22 by 2.5 % between
+  meshes), built at the wave-generator-deflected configuration (gaps evaluated at the deformed FS)
   and linearised about it (small deformation on top of the deflected state).  At +-T
   every pair is re-detected at the deformed state (nonlinear gap); if that finds more
   than 0.05 um penetration (large twists slide the flanks), the pairs near contact are
@@ -117,6 +121,7 @@ BALL_PATCH_FRAC = 0.125  # ball load spread over +-ball_dia/8 of raceway arc
 FRICTION_MAX_IT = 30     # slip-direction iterations per load level (flank friction)
 SLIP_TOL = 1e-7          # mm: a slip below 0.1 nm over a step counts as none
 RELIN_NEAR = 5e-3        # mm: ... but only those pairs closer than this (the loaded flanks)
+CS_TIP_BAND = 0.05       # CS slave nodes of the second contact pass: tip land and corners
 
 
 @dataclass(frozen=True)
@@ -783,23 +788,53 @@ class LostMotionModel:
         return _Rows("fit", G, np.full(nbin, g.r_fs_bore - g.or_outer))
 
     def tooth_rows(self, u_watch: np.ndarray, cand_gap: float,
-                   nodes: np.ndarray | None = None) -> _Rows:
-        """FS tooth-boundary nodes against CS tooth-boundary segments, at the deformed
-        configuration, kept if the gap there is below ``cand_gap``; with ``nodes`` the
-        same slave nodes are re-paired and re-linearised (same rows, new geometry)."""
+                   nodes: tuple[np.ndarray, np.ndarray] | None = None) -> _Rows:
+        """FS/CS tooth contact pairs at the deformed configuration, kept if the gap there is
+        below ``cand_gap``; with ``nodes`` (the ``info["nodes"]`` of earlier rows) the same
+        slave nodes are re-paired and re-linearised (same rows, new geometry).
+
+        Two passes: every FS tooth-boundary node against the CS tooth segments, and the CS
+        tip-land nodes (tip corners included) against the FS tooth segments.  One pass
+        alone lets a CS tip corner sink into an FS flank between two FS nodes; where it
+        bears (the partly engaged teeth away from the major axis) the contact point then
+        jumps with the FS node spacing, and so did Phi between meshes (hd42-lhs-22: 2.5 %).
+        """
         fs, cs = self.bodies["fs"], self.bodies["cs"]
-        sn = (self._indep(fs, np.intersect1d(fs.bm.node_sets["fs_teeth"], fs.watch_nodes))
-              if nodes is None else np.asarray(nodes))
-        xs = fs.x[:, sn] + np.vstack([u_watch[fs.wpos[0, sn]], u_watch[fs.wpos[1, sn]]])
-        E = cs.bm.edge_sets["cs_teeth"]
-        inz = (cs.wpos[0, E[:, 0]] >= 0) & (cs.wpos[0, E[:, 1]] >= 0)
-        E = E[inz]
-        nrm = _boundary_edge_normals(cs.bm.mesh, E)
-        ucs = lambda nodes: np.vstack([u_watch[cs.wpos[0, nodes]], u_watch[cs.wpos[1, nodes]]])
-        xa = cs.x[:, E[:, 0]] + ucs(E[:, 0])
-        xb = cs.x[:, E[:, 1]] + ucs(E[:, 1])
-        mid = 0.5 * (xa + xb)
-        tree = cKDTree(mid.T)
+        if nodes is None:
+            sn_fs = self._indep(fs, np.intersect1d(fs.bm.node_sets["fs_teeth"], fs.watch_nodes))
+            cn = np.intersect1d(cs.bm.node_sets["cs_teeth"], cs.watch_nodes)
+            r_cn = np.hypot(cs.x[0, cn], cs.x[1, cn])
+            tip_band = self.g.r_cs_tip + CS_TIP_BAND * (self.g.r_cs_root - self.g.r_cs_tip)
+            sn_cs = self._indep(cs, cn[r_cn <= tip_band])
+        else:
+            sn_fs, sn_cs = nodes
+        G1, Gt1, g1, k1 = self._node_to_segment(fs, sn_fs, cs, "cs_teeth", u_watch, cand_gap)
+        G2, Gt2, g2, k2 = self._node_to_segment(cs, sn_cs, fs, "fs_teeth", u_watch, cand_gap)
+        sn_fs, sn_cs = sn_fs[k1], sn_cs[k2]
+        # which FS tooth a pair belongs to (teeth in contact); the half model's tooth z/2
+        # is the image of tooth 0 (ids modulo z/2; counted twice)
+        zid = self.g.z_fs // 2 if self.half else self.g.z_fs
+        th = np.concatenate([np.arctan2(fs.x[1, sn_fs], fs.x[0, sn_fs]),
+                             np.arctan2(cs.x[1, sn_cs], cs.x[0, sn_cs])])
+        tooth = np.round(th / (2 * math.pi / self.g.z_fs)).astype(int) % zid
+        return _Rows("tooth", sp.vstack([G1, G2]).tocsr(), np.concatenate([g1, g2]),
+                     {"tooth": tooth, "nodes": (sn_fs, sn_cs),
+                      "Gt": sp.vstack([Gt1, Gt2]).tocsr()})
+
+    def _node_to_segment(self, sb: _Body, sn: np.ndarray, mb: _Body, edge_set: str,
+                         u_watch: np.ndarray, cand_gap: float):
+        """Slave nodes ``sn`` of body ``sb`` against the closest boundary segment of body
+        ``mb`` (group ``edge_set``), gap along the segment's outward normal at the deformed
+        configuration.  Returns (G, Gt, g0, kept): normal and tangential (slip) rows
+        d . (u_slave - u_master point) and the gap g0 + G u of the kept pairs."""
+        xs = sb.x[:, sn] + np.vstack([u_watch[sb.wpos[0, sn]], u_watch[sb.wpos[1, sn]]])
+        E = mb.bm.edge_sets[edge_set]
+        E = E[(mb.wpos[0, E[:, 0]] >= 0) & (mb.wpos[0, E[:, 1]] >= 0)]
+        nrm = _boundary_edge_normals(mb.bm.mesh, E)
+        um = lambda nodes: np.vstack([u_watch[mb.wpos[0, nodes]], u_watch[mb.wpos[1, nodes]]])
+        xa = mb.x[:, E[:, 0]] + um(E[:, 0])
+        xb = mb.x[:, E[:, 1]] + um(E[:, 1])
+        tree = cKDTree((0.5 * (xa + xb)).T)
         kq = min(8, E.shape[0])
         _, cand = tree.query(xs.T, k=kq)
         best = np.full(sn.size, np.inf)
@@ -810,38 +845,38 @@ class LostMotionModel:
             e = cand[:, jj]
             a, b = xa[:, e], xb[:, e]
             d = b - a
-            t = np.clip(((xs - a) * d).sum(0) / (d ** 2).sum(0), 0, 1)
+            t_free = ((xs - a) * d).sum(0) / (d ** 2).sum(0)
+            t = np.clip(t_free, 0, 1)
             pr = a + t * d
             dist = np.hypot(*(xs - pr))
             gap = ((xs - pr) * nrm[:, e]).sum(0)
-            better = dist < best
+            # a node beyond the end of its closest segment faces a corner, not the segment:
+            # its gap is its distance to that corner, never the segment-normal offset
+            # (which made flank nodes "touch" a CS tip land from below)
+            beyond = (t_free < -1e-9) | (t_free > 1 + 1e-9)
+            gap = np.where(beyond & (gap > -dist * 0.999), dist, gap)
+            better = dist < best - 1e-12
             best = np.where(better, dist, best)
             bg, be, bt = (np.where(better, gap, bg), np.where(better, e, be),
                           np.where(better, t, bt))
-        keep = bg < cand_gap
-        sn, bg, be, bt = sn[keep], bg[keep], be[keep], bt[keep]
+        kept = bg < cand_gap
+        sn, bg, be, bt = sn[kept], bg[kept], be[kept], bt[kept]
         n = nrm[:, be]
         k = sn.size
 
         def pair_rows(d):
-            """Rows d . (u_FS node - u_CS point) for a direction d per pair."""
             rows, cols, vals = [], [], []
             for comp in (0, 1):
                 rows += [np.arange(k)] * 3
-                cols += [fs.wpos[comp, sn], cs.wpos[comp, E[be, 0]], cs.wpos[comp, E[be, 1]]]
+                cols += [sb.wpos[comp, sn], mb.wpos[comp, E[be, 0]], mb.wpos[comp, E[be, 1]]]
                 vals += [d[comp], -(1 - bt) * d[comp], -bt * d[comp]]
             return sp.csr_matrix((np.concatenate(vals),
                                   (np.concatenate(rows), np.concatenate(cols))),
                                  shape=(k, self.nwatch))
 
         G = pair_rows(n)
-        Gt = pair_rows(np.vstack([-n[1], n[0]]))   # slip along the CS flank (friction)
-        g0 = bg - G @ u_watch
-        th = np.arctan2(fs.x[1, sn], fs.x[0, sn])
-        # half model: tooth z/2 is the image of tooth 0 (ids modulo z/2; count them twice)
-        zid = self.g.z_fs // 2 if self.half else self.g.z_fs
-        tooth = np.round(th / (2 * math.pi / self.g.z_fs)).astype(int) % zid
-        return _Rows("tooth", G, g0, {"tooth": tooth, "nodes": sn, "Gt": Gt})
+        Gt = pair_rows(np.vstack([-n[1], n[0]]))   # slip along the master segment (friction)
+        return G, Gt, bg - G @ u_watch, kept
 
     @staticmethod
     def _indep(b: _Body, nodes: np.ndarray) -> np.ndarray:
