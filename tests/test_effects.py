@@ -108,3 +108,21 @@ def test_friction_dissipates_and_vanishes_at_zero(drive, baseline):
         assert (unload - load > 0).all(), (mu, load, unload)
         widths.append(float((unload - load).mean()))
     assert min(widths) > 0
+
+
+def test_shared_variants_equal_separate_solves(drive):
+    """The campaign tables come from ``solve_lost_motion_variants`` (one mounted wave
+    generator, a kept CS factorisation for a pure thermal scaling): each variant must give the
+    curve a separate ``solve_lost_motion`` gives, to round-off."""
+    from hdwf.fe import solve_lost_motion_variants
+
+    variants = [ModelChanges(),
+                model_changes({"thermal": {"delta_T_K": 20.0}}),
+                model_changes({"thermal": {"delta_T_K": -30.0}}),
+                model_changes({"cs_housing": {"k_N_per_mm2": 3.0e3}}),
+                model_changes({"tooth_friction": {"mu": 0.1}})]
+    shared = solve_lost_motion_variants(*drive, 5, variants)
+    for ch, res in zip(variants, shared):
+        alone = solve_lost_motion(*drive, steps_per_ramp=5, changes=ch)
+        assert res.status == alone.status == "ok", (res.reason, alone.reason)
+        np.testing.assert_allclose(res.twist_arcmin, alone.twist_arcmin, rtol=0, atol=1e-8)

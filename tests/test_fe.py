@@ -271,3 +271,23 @@ def test_rigid_body_limit_half_equals_full():
     half = _run("hd42", 31.0, 42.0, 0.015, 0.015, 0.010, Escale=1e4, symmetry="half")
     full = _run("hd42", 31.0, 42.0, 0.015, 0.015, 0.010, Escale=1e4)
     assert half.lost_motion_arcmin == pytest.approx(full.lost_motion_arcmin, rel=5e-3)
+
+
+def test_closest_segment_gap_is_corner_distance_beyond_a_segment():
+    """A tip land from (0, 0) to (1, 0), material above (outward normal -y), a flank going up
+    from its right corner. A point beside the flank, beyond the land's end and above the land
+    line, is 0.5 away from the corner: its gap is that distance, not the normal offset -0.3
+    that made flank nodes "touch" a CS tip land from below. A point under the land keeps its
+    normal gap; a point inside the land's strip and above it penetrates by the offset."""
+    from hdwf.fe import _closest_segments
+
+    xa = np.array([[0.0, 1.0], [0.0, 0.0]])          # land (0,0)->(1,0), flank (1,0)->(1.6,2)
+    xb = np.array([[1.0, 1.6], [0.0, 2.0]])
+    d = xb - xa
+    nrm = np.vstack([d[1], -d[0]]) / np.linalg.norm(d, axis=0)   # right-hand normals
+    nrm[:, 0] = [0.0, -1.0]                          # land faces down (out of the material)
+    pts = np.array([[1.4, 0.3], [0.5, -0.2], [0.5, 0.05]]).T
+    gap, seg, t = _closest_segments(pts, xa, xb, nrm)
+    assert gap[0] == pytest.approx(0.5) and seg[0] == 0 and t[0] == 1.0
+    assert gap[1] == pytest.approx(0.2) and seg[1] == 0
+    assert gap[2] == pytest.approx(-0.05) and seg[2] == 0

@@ -227,22 +227,15 @@ def campaign_plan(name: str, camp: dict, fe: dict) -> CampaignPlan:
 
 
 def specimen_stage(unit: str, specimen: dict, settings: dict, steps_per_ramp: int, variants: list[dict],
-                   out, provenance: dict, reuse=None) -> pd.DataFrame:
-    """Mesh one specimen once and solve it for every variant; rows already in ``reuse``
-    (a table of the same specimen and mesh) are copied, not solved again."""
+                   out, provenance: dict) -> pd.DataFrame:
+    """Mesh one specimen once and solve it for every variant (one campaign table)."""
     from .fe_study import _mesh, geometry_of
     from .io import write_parquet
 
     sid = specimen["specimen_id"]
     params = {c: float(specimen[c]) for c in PARAMETER_COLUMNS}
-    have = pd.read_parquet(reuse) if reuse else pd.DataFrame(columns=TABLE_COLUMNS)
-    keys = [variant_key(v) for v in variants]
-    todo = [v for v, k in zip(variants, keys) if k not in set(have["variant"])]
-    frames = [have[have["variant"].isin(keys)]]
-    if todo:
-        mesh = _mesh(geometry_of(unit, params), settings)
-        frames.append(solve_variants(unit, params, mesh, steps_per_ramp, todo, sid))
-    table = pd.concat(frames, ignore_index=True)[TABLE_COLUMNS]
+    mesh = _mesh(geometry_of(unit, params), settings)
+    table = solve_variants(unit, params, mesh, steps_per_ramp, variants, sid)[TABLE_COLUMNS]
     write_parquet(table, out, provenance=provenance,
                   meta={"unit": unit, "specimen_id": sid, "mesh": settings})
     return table

@@ -432,15 +432,30 @@ def diagnosis_stage(measurements_path, table_paths, plan, out_json, out_points, 
     return result
 
 
-def ladder_stage(measurements_path, diagnosis_json, table_paths, out, provenance: dict) -> pd.DataFrame:
+def ladder_stage(measurements_path, diagnosis_json, table_paths, out, provenance: dict,
+                 unit: str, settings: dict, steps_per_ramp: int, jobs: int = 1) -> pd.DataFrame:
+    """The ladder of a campaign from actual solves: every rung's variant is looked up in the
+    specimens' tables and solved (mesh, wave generator and the missing variants only) where a
+    table lacks it, i.e. for the found effects at their calibrated values."""
     import json
 
+    from .campaign import solve_specimens
     from .io import write_parquet
     from .measurements import load_measurements
 
     meas = load_measurements(measurements_path)
     diag = json.loads(open(diagnosis_json).read())
     table = pd.concat([pd.read_parquet(p) for p in table_paths], ignore_index=True)
+    rungs = [eff for _, eff in ladder_variants(diag)]
+    have = table.groupby("specimen_id")["variant"].agg(set).to_dict()
+    todo = {sid: [eff for eff in rungs if variant_key(eff) not in have.get(sid, set())]
+            for sid in meas.specimens["specimen_id"]}
+    need = meas.specimens[[bool(todo[sid]) for sid in meas.specimens["specimen_id"]]]
+    if len(need):
+        solved = solve_specimens(unit, need, settings, steps_per_ramp, todo.__getitem__, jobs=jobs)
+        table = pd.concat([table, solved], ignore_index=True)
     ladder = ladder_table(meas, table, diag)
-    write_parquet(ladder, out, provenance=provenance, meta={"campaign": diag["campaign"], "unit": diag["unit"]})
+    write_parquet(ladder, out, provenance=provenance,
+                  meta={"campaign": diag["campaign"], "unit": diag["unit"],
+                        "solved_for_ladder": int(sum(len(v) for v in todo.values()))})
     return ladder

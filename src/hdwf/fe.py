@@ -479,6 +479,40 @@ def _boundary_edge_normals(mesh, edges: np.ndarray) -> np.ndarray:
     return n
 
 
+def _closest_segments(xs: np.ndarray, xa: np.ndarray, xb: np.ndarray, nrm: np.ndarray):
+    """For each point of ``xs`` (2 x n) the closest of the segments a->b (2 x m, outward unit
+    normals ``nrm``): (signed gap, segment index, parameter t in [0, 1] of the closest point).
+    The gap is the offset along the segment's normal, except for a point beyond the end of its
+    closest segment: that point faces a corner, and its gap is its distance to the corner
+    (the normal offset there would let a flank node "touch" a tip land from below)."""
+    tree = cKDTree((0.5 * (xa + xb)).T)
+    kq = min(8, xa.shape[1])
+    _, cand = tree.query(xs.T, k=kq)
+    cand = cand.reshape(xs.shape[1], kq)
+    best = np.full(xs.shape[1], np.inf)
+    bg = np.zeros(xs.shape[1])
+    be = np.zeros(xs.shape[1], dtype=np.int64)
+    bt = np.zeros(xs.shape[1])
+    for jj in range(kq):
+        e = cand[:, jj]
+        a, b = xa[:, e], xb[:, e]
+        d = b - a
+        t_free = ((xs - a) * d).sum(0) / (d ** 2).sum(0)
+        t = np.clip(t_free, 0, 1)
+        pr = a + t * d
+        dist = np.hypot(*(xs - pr))
+        gap = ((xs - pr) * nrm[:, e]).sum(0)
+        beyond = (t_free < -1e-9) | (t_free > 1 + 1e-9)
+        # (outside the body: near a convex corner an inside point projects into an edge;
+        # the concave root corners never bear, the tip/root clearance is 0.1 h)
+        gap = np.where(beyond, dist, gap)
+        better = dist < best - 1e-12
+        best = np.where(better, dist, best)
+        bg, be, bt = (np.where(better, gap, bg), np.where(better, e, be),
+                      np.where(better, t, bt))
+    return bg, be, bt
+
+
 # --------------------------------------------------------------------------------------
 # Result
 # --------------------------------------------------------------------------------------
@@ -646,10 +680,22 @@ class LostMotionModel:
         if (changes.cs_scale, changes.cs_rim_stiffness_N_mm2) != (old.cs_scale,
                                                                    old.cs_rim_stiffness_N_mm2):
             prev = self.bodies["cs"]
-            b, tf = self._build_cs(changes)
-            b.wofs, b.wpos = prev.wofs, prev.wpos
-            self.bodies["cs"] = b
-            self.factorize_s += tf
+            if (changes.cs_rim_stiffness_N_mm2 == old.cs_rim_stiffness_N_mm2
+                    and not math.isfinite(old.cs_rim_stiffness_N_mm2) and not prev.modes):
+                # a clamped CS only scaled (thermal strain): a uniformly scaled plane-stress
+                # body has the same stiffness matrix (B ~ 1/s, area ~ s^2), so the
+                # factorisation is kept and only the coordinates move
+                from skfem import MeshTri
+                s = changes.cs_scale / old.cs_scale
+                bm = prev.bm
+                self.bodies["cs"] = replace(prev, bm=BodyMesh(
+                    name=bm.name, mesh=MeshTri(bm.mesh.p * s, bm.mesh.t), thickness=bm.thickness,
+                    node_sets=bm.node_sets, edge_sets=bm.edge_sets))
+            else:
+                b, tf = self._build_cs(changes)
+                b.wofs, b.wpos = prev.wofs, prev.wpos
+                self.bodies["cs"] = b
+                self.factorize_s += tf
         self.mu = float(changes.flank_friction)
         if self.mu > 0 and self.CWY.shape[0] != len(self.W):
             n = len(self.W)      # the mounted contacts have no slip rows: zero columns
@@ -834,31 +880,7 @@ class LostMotionModel:
         um = lambda nodes: np.vstack([u_watch[mb.wpos[0, nodes]], u_watch[mb.wpos[1, nodes]]])
         xa = mb.x[:, E[:, 0]] + um(E[:, 0])
         xb = mb.x[:, E[:, 1]] + um(E[:, 1])
-        tree = cKDTree((0.5 * (xa + xb)).T)
-        kq = min(8, E.shape[0])
-        _, cand = tree.query(xs.T, k=kq)
-        best = np.full(sn.size, np.inf)
-        bg = np.zeros(sn.size)
-        be = np.zeros(sn.size, dtype=np.int64)
-        bt = np.zeros(sn.size)
-        for jj in range(kq):
-            e = cand[:, jj]
-            a, b = xa[:, e], xb[:, e]
-            d = b - a
-            t_free = ((xs - a) * d).sum(0) / (d ** 2).sum(0)
-            t = np.clip(t_free, 0, 1)
-            pr = a + t * d
-            dist = np.hypot(*(xs - pr))
-            gap = ((xs - pr) * nrm[:, e]).sum(0)
-            # a node beyond the end of its closest segment faces a corner, not the segment:
-            # its gap is its distance to that corner, never the segment-normal offset
-            # (which made flank nodes "touch" a CS tip land from below)
-            beyond = (t_free < -1e-9) | (t_free > 1 + 1e-9)
-            gap = np.where(beyond & (gap > -dist * 0.999), dist, gap)
-            better = dist < best - 1e-12
-            best = np.where(better, dist, best)
-            bg, be, bt = (np.where(better, gap, bg), np.where(better, e, be),
-                          np.where(better, t, bt))
+        bg, be, bt = _closest_segments(xs, xa, xb, nrm)
         kept = bg < cand_gap
         sn, bg, be, bt = sn[kept], bg[kept], be[kept], bt[kept]
         n = nrm[:, be]

@@ -14,8 +14,6 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 import pandas as pd
-import statsmodels.api as sm
-from statsmodels.stats.diagnostic import linear_reset
 
 from . import PARAMETER_COLUMNS
 
@@ -94,6 +92,11 @@ def summarise(points: pd.DataFrame, u_num: float = 0.0, u_input: float = 0.0) ->
 
 def residual_tests(points: pd.DataFrame) -> pd.DataFrame:
     """statsmodels tests on the comparison error, with p-values (small p: a pattern the model misses)."""
+    # imported here: statsmodels takes a second to import, and the per-specimen jobs that
+    # import this module never run the tests
+    import statsmodels.api as sm
+    from statsmodels.stats.diagnostic import linear_reset
+
     rows = []
     spec = points.groupby("specimen_id", sort=False).agg(E=("E", "mean"), **{c: (c, "first") for c in PARAMETER_COLUMNS})
     X = spec[list(PARAMETER_COLUMNS)].to_numpy(float)

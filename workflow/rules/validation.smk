@@ -92,37 +92,26 @@ rule validation_diagnosis:
         "../scripts/validation_diagnosis.py"
 
 
-rule validation_ladder_specimen:
+rule validation_ladder:
+    # one job per campaign: a rung needs one or two solves per specimen, fewer seconds than
+    # a job per specimen spends starting up
     input:
+        measurements=lambda w: CAMPAIGNS[w.campaign].measurements,
         diagnosis="results/validation/{campaign}/diagnosis.json",
-        table="results/validation/{campaign}/tables/{specimen}.parquet",
+        tables=lambda w: expand("results/validation/{campaign}/tables/{specimen}.parquet",
+                                campaign=w.campaign, specimen=specimen_ids(w.campaign)),
     output:
-        "results/validation/{campaign}/ladder/{specimen}.parquet",
+        "results/validation/{campaign}/ladder.parquet",
     params:
         unit=lambda w: CAMPAIGNS[w.campaign].unit,
-        specimen=specimen_row,
         settings=lambda w: CAMPAIGNS[w.campaign].settings,
         steps_per_ramp=lambda w: CAMPAIGNS[w.campaign].steps_per_ramp,
         repo=REPO_DIR,
     threads: 1
     resources:
         mem_mb=4000,
-    log:
-        "results/logs/validation_{campaign}_ladder_{specimen}.log",
-    script:
-        "../scripts/validation_ladder_specimen.py"
-
-
-rule validation_ladder:
-    input:
-        measurements=lambda w: CAMPAIGNS[w.campaign].measurements,
-        diagnosis="results/validation/{campaign}/diagnosis.json",
-        tables=lambda w: expand("results/validation/{campaign}/ladder/{specimen}.parquet",
-                                campaign=w.campaign, specimen=specimen_ids(w.campaign)),
-    output:
-        "results/validation/{campaign}/ladder.parquet",
-    params:
-        repo=REPO_DIR,
+    benchmark:
+        "results/validation/{campaign}/benchmarks/ladder.tsv"
     log:
         "results/logs/validation_{campaign}_ladder.log",
     script:
