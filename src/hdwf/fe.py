@@ -33,10 +33,10 @@ Contacts (unilateral, frictionless), rows of a gap operator g = g0 + G u >= 0:
   jump by up to 4 % from one mesh to the next;
 * FS - CS flanks: node-to-segment in two passes (FS flank/tip nodes against CS boundary
   segments; CS tip-land and tip-corner nodes against FS boundary segments), a node beyond
-  the end of its closest segment measuring its distance to that corner (otherwise FS flank
-  nodes below a CS tip land "touched" it along the land's normal: a false contact that
-  came and went with the node spacing and moved Phi of hd42-lhs-22 by 2.5 % between
-  meshes), built at the wave-generator-deflected configuration (gaps evaluated at the deformed FS)
+  the end of its closest segment measuring its distance to that corner (its offset along
+  the segment's normal is the gap to the segment's straight extension: FS flank nodes
+  beside a CS tip "touched" the extension of the tip land, a false contact that came and
+  went with the node spacing and moved Phi of hd42-lhs-22 by 2.5 % between meshes), built at the wave-generator-deflected configuration (gaps evaluated at the deformed FS)
   and linearised about it (small deformation on top of the deflected state).  At +-T
   every pair is re-detected at the deformed state (nonlinear gap); if that finds more
   than 0.05 um penetration (large twists slide the flanks), the pairs near contact are
@@ -484,7 +484,7 @@ def _closest_segments(xs: np.ndarray, xa: np.ndarray, xb: np.ndarray, nrm: np.nd
     normals ``nrm``): (signed gap, segment index, parameter t in [0, 1] of the closest point).
     The gap is the offset along the segment's normal, except for a point beyond the end of its
     closest segment: that point faces a corner, and its gap is its distance to the corner
-    (the normal offset there would let a flank node "touch" a tip land from below)."""
+    (the normal offset there is the gap to the segment's straight extension)."""
     tree = cKDTree((0.5 * (xa + xb)).T)
     kq = min(8, xa.shape[1])
     _, cand = tree.query(xs.T, k=kq)
@@ -502,9 +502,10 @@ def _closest_segments(xs: np.ndarray, xa: np.ndarray, xb: np.ndarray, nrm: np.nd
         pr = a + t * d
         dist = np.hypot(*(xs - pr))
         gap = ((xs - pr) * nrm[:, e]).sum(0)
+        # beyond the segment's end: in the fan outside a corner, so outside the body (inside
+        # a convex corner a point projects into an edge; the concave root corners never
+        # bear, the tip/root clearance is 0.1 h)
         beyond = (t_free < -1e-9) | (t_free > 1 + 1e-9)
-        # (outside the body: near a convex corner an inside point projects into an edge;
-        # the concave root corners never bear, the tip/root clearance is 0.1 h)
         gap = np.where(beyond, dist, gap)
         better = dist < best - 1e-12
         best = np.where(better, dist, best)
@@ -840,10 +841,10 @@ class LostMotionModel:
         slave nodes are re-paired and re-linearised (same rows, new geometry).
 
         Two passes: every FS tooth-boundary node against the CS tooth segments, and the CS
-        tip-land nodes (tip corners included) against the FS tooth segments.  One pass
-        alone lets a CS tip corner sink into an FS flank between two FS nodes; where it
-        bears (the partly engaged teeth away from the major axis) the contact point then
-        jumps with the FS node spacing, and so did Phi between meshes (hd42-lhs-22: 2.5 %).
+        tip-land nodes (tip corners included) against the FS tooth segments: one pass alone
+        would let a CS tip corner sink into an FS flank between two FS nodes.  A node beyond
+        the end of its closest segment gets its distance to the corner as its gap
+        (``_closest_segments``).
         """
         fs, cs = self.bodies["fs"], self.bodies["cs"]
         if nodes is None:

@@ -57,6 +57,7 @@ class Document:
         self._figures: list[Path] = []
 
     def heading(self, text, level=1):
+        """``text`` is plain text (typst shows it as it is), not markup: do not escape it."""
         self.blocks.append({"type": "heading", "level": level, "text": text})
 
     def text(self, markup: str):
@@ -467,9 +468,9 @@ def _validation_section(doc: Document, campaign: str, files: dict, level: int = 
     ladder = pd.read_parquet(files["ladder"])
     unit = diag["unit"]
     b = diag["baseline"]
-    doc.heading(f"Campaign '{lit(campaign)}' ({UNIT_NAMES[unit]})", level)
+    doc.heading(f"Campaign '{campaign}' ({UNIT_NAMES[unit]})", level)
     noise = diag.get("noise_arcmin")
-    doc.text(f"Measurements: `{lit(diag['measurements'])}`, {diag['n_specimens']} specimens, {diag['n_points']} values "
+    doc.text(f"Measurements: {lit(diag['measurements'])}, {diag['n_specimens']} specimens, {diag['n_points']} values "
              f"({lit(diag['form'])} form)" + (f", stated noise {fmt(noise, 4)} arcmin" if noise else ", no noise stated")
              + f". Model: our FE model on a mesh of {diag['mesh']['elements_over_height']} × "
              f"{diag['mesh']['elements_over_thickness']} elements per tooth"
@@ -555,7 +556,7 @@ def full_report(files: dict[str, str], studies: dict[str, dict], data_dir, prove
         tmp = Path(tmp)
         for study in paper_studies:
             units, f, cfg = studies[study]["units"], _sub(files, study), studies[study]
-            doc.heading(f"Part I — the paper's FEA tables (study '{lit(study)}')", 1)
+            doc.heading(f"Part I — the paper's FEA tables (study '{study}')", 1)
             _inputs_section(doc, units, data_dir, cfg, 2)
             _designs_section(doc, units, f, 2)
             _correlation_section(doc, units, f, 2)
@@ -581,7 +582,7 @@ def full_report(files: dict[str, str], studies: dict[str, dict], data_dir, prove
             for study in fe_studies:
                 units, f = studies[study]["units"], _sub(files, study)
                 doc.pagebreak()
-                doc.heading(f"Study '{lit(study)}'", 2)
+                doc.heading(f"Study '{study}'", 2)
                 _correlation_section(doc, units, f, 3)
                 _surrogate_section(doc, units, f, 3)
                 _sobol_section(doc, units, f, 3)
