@@ -36,7 +36,8 @@ Contacts (unilateral, frictionless), rows of a gap operator g = g0 + G u >= 0:
   the end of its closest segment measuring its distance to that corner (its offset along
   the segment's normal is the gap to the segment's straight extension: FS flank nodes
   beside a CS tip "touched" the extension of the tip land, a false contact that came and
-  went with the node spacing and moved Phi of hd42-lhs-22 by 2.5 % between meshes), built at the wave-generator-deflected configuration (gaps evaluated at the deformed FS)
+  went with the node spacing and moved Phi of hd42-lhs-22 by 2.5 % between meshes),
+  built at the wave-generator-deflected configuration (gaps evaluated at the deformed FS)
   and linearised about it (small deformation on top of the deflected state).  At +-T
   every pair is re-detected at the deformed state (nonlinear gap); if that finds more
   than 0.05 um penetration (large twists slide the flanks), the pairs near contact are
@@ -274,6 +275,19 @@ class _Body:
     @property
     def x(self):
         return self.bm.mesh.p
+
+
+def _scaled(bm: BodyMesh, s: float) -> BodyMesh:
+    """The body mesh scaled about the axis by ``s`` (same nodes, elements and groups)."""
+    from skfem import MeshTri
+
+    return BodyMesh(name=bm.name, mesh=MeshTri(bm.mesh.p * s, bm.mesh.t), thickness=bm.thickness,
+                    node_sets=bm.node_sets, edge_sets=bm.edge_sets)
+
+
+def _node_u(b: "_Body", nodes: np.ndarray, u_watch: np.ndarray) -> np.ndarray:
+    """Displacements (2 x n) of watched ``nodes`` of body ``b`` from the watch vector."""
+    return np.vstack([u_watch[b.wpos[0, nodes]], u_watch[b.wpos[1, nodes]]])
 
 
 def _pin_nodes(p: np.ndarray, boundary: np.ndarray, r_mid: float):
@@ -642,11 +656,7 @@ class LostMotionModel:
 
     def _build_cs(self, changes: ModelChanges) -> tuple[_Body, float]:
         """The CS body: scaled (thermal strain) and on rim springs (housing) as ``changes`` say."""
-        bm = self._cs_mesh0
-        if changes.cs_scale != 1.0:
-            from skfem import MeshTri
-            bm = BodyMesh(name=bm.name, mesh=MeshTri(bm.mesh.p * changes.cs_scale, bm.mesh.t),
-                          thickness=bm.thickness, node_sets=bm.node_sets, edge_sets=bm.edge_sets)
+        bm = self._cs_mesh0 if changes.cs_scale == 1.0 else _scaled(self._cs_mesh0, changes.cs_scale)
         springs = None
         if math.isfinite(changes.cs_rim_stiffness_N_mm2):
             springs = changes.cs_rim_stiffness_N_mm2 * _boundary_lengths(bm.mesh,
@@ -686,12 +696,7 @@ class LostMotionModel:
                 # a clamped CS only scaled (thermal strain): a uniformly scaled plane-stress
                 # body has the same stiffness matrix (B ~ 1/s, area ~ s^2), so the
                 # factorisation is kept and only the coordinates move
-                from skfem import MeshTri
-                s = changes.cs_scale / old.cs_scale
-                bm = prev.bm
-                self.bodies["cs"] = replace(prev, bm=BodyMesh(
-                    name=bm.name, mesh=MeshTri(bm.mesh.p * s, bm.mesh.t), thickness=bm.thickness,
-                    node_sets=bm.node_sets, edge_sets=bm.edge_sets))
+                self.bodies["cs"] = replace(prev, bm=_scaled(prev.bm, changes.cs_scale / old.cs_scale))
             else:
                 b, tf = self._build_cs(changes)
                 b.wofs, b.wpos = prev.wofs, prev.wpos
@@ -778,8 +783,7 @@ class LostMotionModel:
         ir = self.bodies["ir"]
         nodes = self._indep(ir, ir.bm.node_sets["ir_bore"])
         X = ir.x[:, nodes]
-        u = np.vstack([u_watch[ir.wpos[0, nodes]], u_watch[ir.wpos[1, nodes]]])
-        x = X + u
+        x = X + _node_u(ir, nodes, u_watch)
         cp = cam_points(self.g.cam_A, self.g.cam_B, self.g.cam_n, 32768)
         tree = cKDTree(cp)
         _, j = tree.query(x.T)
@@ -874,13 +878,12 @@ class LostMotionModel:
         ``mb`` (group ``edge_set``), gap along the segment's outward normal at the deformed
         configuration.  Returns (G, Gt, g0, kept): normal and tangential (slip) rows
         d . (u_slave - u_master point) and the gap g0 + G u of the kept pairs."""
-        xs = sb.x[:, sn] + np.vstack([u_watch[sb.wpos[0, sn]], u_watch[sb.wpos[1, sn]]])
+        xs = sb.x[:, sn] + _node_u(sb, sn, u_watch)
         E = mb.bm.edge_sets[edge_set]
         E = E[(mb.wpos[0, E[:, 0]] >= 0) & (mb.wpos[0, E[:, 1]] >= 0)]
         nrm = _boundary_edge_normals(mb.bm.mesh, E)
-        um = lambda nodes: np.vstack([u_watch[mb.wpos[0, nodes]], u_watch[mb.wpos[1, nodes]]])
-        xa = mb.x[:, E[:, 0]] + um(E[:, 0])
-        xb = mb.x[:, E[:, 1]] + um(E[:, 1])
+        xa = mb.x[:, E[:, 0]] + _node_u(mb, E[:, 0], u_watch)
+        xb = mb.x[:, E[:, 1]] + _node_u(mb, E[:, 1], u_watch)
         bg, be, bt = _closest_segments(xs, xa, xb, nrm)
         kept = bg < cand_gap
         sn, bg, be, bt = sn[kept], bg[kept], be[kept], bt[kept]
