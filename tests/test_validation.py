@@ -69,3 +69,34 @@ def test_verdict_names_the_effect_ties_and_none():
     assert [r["effect"] for r in v["ranking"]] == ["tooth_friction", "cs_housing", "thermal"]
     none = verdict(base, [weak])
     assert none["verdict"]["missing_effect"] is None and "no missing effect" in none["verdict"]["text"]
+
+
+def _linear_response(g):
+    """Flank friction's response made exactly linear in mu: the change at mu is mu * g."""
+    from hdwf.diagnosis import Response
+
+    t = np.array([0.0, 0.1, 0.2, 0.3])
+    return Response("tooth_friction", "mu", t, t[:, None] * g[None, :], (0.0, 0.3))
+
+
+def test_detectability_of_a_linear_effect():
+    """Change at the realistic mu = 0.08 is 0.08 g; the parameter's relative sd is sigma/|change|
+    (linear least squares); at the stated 'noise to show' the effect earns exactly the pay
+    threshold, ΔBIC = -10, by the BIC of hdwf.validation."""
+    from hdwf.diagnosis import detectability
+
+    rng = np.random.default_rng(3)
+    g = rng.normal(0.0, 1.0, 200)
+    resp = {"tooth_friction": _linear_response(g)}
+    size = 0.08 * np.linalg.norm(g)
+    row, = detectability(resp, noise=0.05, n=200)
+    assert row["change_rms_arcmin"] == pytest.approx(size / np.sqrt(200), rel=1e-9)
+    assert row["expected_rel_sd"] == pytest.approx(0.05 / size, rel=1e-9)
+    s = row["noise_to_show_arcmin"]
+    # data holding the effect (RSS n s^2 + |change|^2) against the fitted model (RSS n s^2), one more parameter
+    d_bic = bic(200 * s**2, 200, 1) - bic(200 * s**2 + size**2, 200, 0)
+    assert d_bic == pytest.approx(-10.0, abs=1e-9)
+    assert row["visible"] == (0.05 < s)
+    assert row["noise_to_calibrate_arcmin"] == pytest.approx(0.075 * size)
+    # twice the noise at which it just shows: no longer visible
+    assert detectability(resp, noise=2 * s, n=200)[0]["visible"] is False

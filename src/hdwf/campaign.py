@@ -171,6 +171,13 @@ def synthesize(unit: str, n_designs: int, seed: int, noise_arcmin: float,
     with ``u_twist_arcmin`` = the noise level. A failed solve raises (no silent rows)."""
     if noise_arcmin < 0 or not math.isfinite(noise_arcmin):
         raise ValueError(f"noise_arcmin must be >= 0, got {noise_arcmin!r}")
+    return add_noise(synth_curves(unit, n_designs, seed, effects, settings, steps_per_ramp, jobs),
+                     noise_arcmin, seed)
+
+
+def synth_curves(unit: str, n_designs: int, seed: int, effects: dict[str, dict[str, float]] | None,
+                 settings: dict, steps_per_ramp: int = 5, jobs: int = 1) -> pd.DataFrame:
+    """The noise-free curves ``synthesize`` starts from (one solve per specimen)."""
     specimens = synth_designs(unit, n_designs, seed)
     effects = effects or {}
     model_changes(effects)    # checks names, parameters and bounds before any solve
@@ -179,8 +186,13 @@ def synthesize(unit: str, n_designs: int, seed: int, noise_arcmin: float,
     if len(bad):
         raise RuntimeError(f"synthesis: the FE solve failed for specimen "
                            f"{bad['specimen_id'].iloc[0]}: {bad['status'].iloc[0]}")
+    return specimens.merge(table.drop(columns=["variant", "status"]), on="specimen_id")
+
+
+def add_noise(curves: pd.DataFrame, noise_arcmin: float, seed: int) -> pd.DataFrame:
+    """Gaussian noise of ``noise_arcmin`` on every twist (``numpy`` generator seeded with ``seed``)."""
     rng = np.random.default_rng(seed)
-    data = specimens.merge(table.drop(columns=["variant", "status"]), on="specimen_id")
+    data = curves.copy()
     data["twist_arcmin"] = data["twist_arcmin"] + rng.normal(0.0, noise_arcmin, len(data))
     data["u_twist_arcmin"] = noise_arcmin
     return data[["specimen_id", "unit", *PARAMETER_COLUMNS, "step", "torque_Nm", "twist_arcmin",

@@ -19,7 +19,13 @@ Method (hand-written around scipy/statsmodels; see docs/validation.md):
 * verdict (``hdwf.validation.verdict``): a candidate pays when ΔBIC <= -10 and its
   leave-one-out error beats the current model's; paying candidates within ΔBIC 6 of the
   best are reported as indistinguishable; none paying -> "no missing effect found";
-* greedy: the winner is switched on and the search repeats for the next effect.
+* greedy: the winner is switched on and the search repeats for the next effect;
+* what the data could see (``detectability``): each candidate at its realistic value changes
+  the predictions by a vector Δ; against the noise σ (stated, or else the final model's
+  residual, an upper bound) it would be found when the ΔBIC it earns,
+  -n ln(1 + |Δ|²/(n σ²)) + ln n, clears the pay threshold, and its parameter would come out
+  with relative standard deviation σ/|Δ| (linearised, other effects held).  A "no missing
+  effect found" therefore says which candidates this data could not have seen at all.
 """
 
 from __future__ import annotations
@@ -234,6 +240,33 @@ def loo_rmse(D, S0, resp, effects, fit: Fit, specimen: np.ndarray) -> float:
     return float(np.sqrt(np.mean(err ** 2)))
 
 
+def detectability(resp: dict[str, Response], noise: float, n: int, pay_threshold: float = 10.0) -> list[dict]:
+    """Could this data show each candidate at its realistic value? (see the module docstring)
+
+    ``noise`` is the standard deviation of one observation (arcmin), ``n`` their number.
+    Returns one row per candidate: the change at the realistic value (RMS and largest, arcmin),
+    the ΔBIC it would earn, the relative standard deviation of its calibrated parameter, the
+    noise at which it would just pay and the noise at which its parameter would come out
+    within 15 % at two standard deviations."""
+    need = pay_threshold + math.log(n)      # -ΔBIC to pay, when adding one parameter
+    rows = []
+    for name, r in resp.items():
+        p = get_effect(name).param(r.param)
+        delta = r.change(p.to_t(p.realistic))
+        size = float(np.linalg.norm(delta))
+        chi2 = (size / noise) ** 2 if noise > 0 else math.inf
+        # the noise s that solves n ln(1 + size²/(n s²)) = need
+        show = size / math.sqrt(n * math.expm1(need / n)) if size > 0 else 0.0
+        rows.append({"effect": name, "param": r.param, "realistic": p.realistic, "unit": p.unit,
+                     "change_rms_arcmin": size / math.sqrt(n), "change_max_arcmin": float(np.max(np.abs(delta))),
+                     "expected_delta_bic": float(-n * math.log1p(chi2 / n) + math.log(n)) if math.isfinite(chi2)
+                     else -math.inf,
+                     "expected_rel_sd": (1.0 / math.sqrt(chi2)) if chi2 > 0 else math.inf,
+                     "noise_to_show_arcmin": show, "noise_to_calibrate_arcmin": 0.075 * size,
+                     "visible": bool(size > 0 and noise < show)})
+    return rows
+
+
 def _cosine(a: np.ndarray, b: np.ndarray) -> float:
     na, nb = np.linalg.norm(a), np.linalg.norm(b)
     return float(a @ b / (na * nb)) if na > 0 and nb > 0 else 0.0
@@ -316,6 +349,12 @@ def diagnose(meas, table: pd.DataFrame, fixed: dict | None = None, calibrate_fir
     found = [{"effect": e, "params": fit.params(resp)[e], "param_sd": fit.param_sd(resp)[e]} for e in on]
     final_rmse = float(np.sqrt(fit.rss / len(D)))
     noise = float(np.sqrt(np.nanmean(obs["u_D"].to_numpy(float) ** 2))) if np.isfinite(obs["u_D"]).any() else None
+    if noise is not None:
+        sigma, sigma_from = noise, "the noise stated in the measurement file"
+    else:
+        sigma = float(np.sqrt(fit.rss / max(len(D) - len(on), 1)))
+        sigma_from = "the residual of the final model (no noise stated: an upper bound on the noise)"
+    seen = detectability(resp, sigma, len(D), pay_threshold)
     points = obs.copy()
     points["S_model"] = S0
     points["S_final"] = fit.S
@@ -334,7 +373,10 @@ def diagnose(meas, table: pd.DataFrame, fixed: dict | None = None, calibrate_fir
                      else summary.share_beyond_2uval},
         "ranking": first["ranking"],
         "verdict": {**first["verdict"],
-                    "found_in_order": [f["effect"] for f in found if f["effect"] not in calibrate_first]},
+                    "found_in_order": [f["effect"] for f in found if f["effect"] not in calibrate_first],
+                    "could_not_see": [r["effect"] for r in seen if not r["visible"]]},
+        "detectability": {"noise_arcmin": sigma, "noise_from": sigma_from, "pay_threshold": pay_threshold,
+                          "candidates": seen},
         "rounds": rounds,
         "found": found,
         "final": {"effects": fit.params(resp), "rmse_arcmin": final_rmse,

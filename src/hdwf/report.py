@@ -463,6 +463,38 @@ def _effect_sentence(r: dict) -> str:
     return f"*{lit(eff.title)}* ({lit(pname)} = {value})"
 
 
+def _detectability_part(doc: Document, diag: dict, level: int):
+    """Which candidates this data could have shown at all (diagnosis.json: detectability)."""
+    det = diag.get("detectability")
+    if not det:
+        return
+    from .effects import get as get_effect
+
+    doc.heading("What this data could show", level)
+    rows = []
+    for c in det["candidates"]:
+        p = get_effect(c["effect"]).param(c["param"])
+        rows.append([lit(c["effect"]), f"{lit(p.name)} = {fmt(c['realistic'], 3)} {lit(p.unit)}",
+                     fmt(c["change_rms_arcmin"], 3), fmt(c["change_max_arcmin"], 3),
+                     fmt(c["noise_to_show_arcmin"], 3), fmt(c["noise_to_calibrate_arcmin"], 3),
+                     fmt(c["expected_delta_bic"], 1), f"{fmt(100 * c['expected_rel_sd'], 2)} %",
+                     "yes" if c["visible"] else "no"])
+    doc.table(["effect", "realistic value", "change RMS", "change max", "noise to show", "noise to calibrate",
+               "ΔBIC", "sd of parameter", "visible"], rows,
+              f"Each candidate at a realistic value, against a noise of {fmt(det['noise_arcmin'], 4)} arcmin per value "
+              f"({lit(det['noise_from'])}). Change: what the effect does to the predictions (arcmin). Noise to show: the "
+              "largest noise at which it would still pay (ΔBIC ≤ −10); noise to calibrate: at which its parameter would "
+              "come out within 15 % (two standard deviations). ΔBIC and sd: what this data would give if the effect "
+              "were there at that value (linearised).")
+    hidden = [c for c in det["candidates"] if not c["visible"]]
+    if hidden:
+        doc.text("This data could not have shown " + ", ".join(
+            f"{lit(get_effect(c['effect']).title.lower())} (its change, {fmt(c['change_rms_arcmin'], 2)} arcmin RMS, "
+            f"needs noise below {fmt(c['noise_to_show_arcmin'], 2)} arcmin)" for c in hidden)
+            + ": a verdict without them is not evidence that they are absent. Less noise (averaged repeat runs, a "
+            "finer encoder) or more specimens would show them.")
+
+
 def _validation_section(doc: Document, campaign: str, files: dict, level: int = 2):
     diag = json.loads(Path(files["diagnosis"]).read_text())
     ladder = pd.read_parquet(files["ladder"])
@@ -526,6 +558,7 @@ def _validation_section(doc: Document, campaign: str, files: dict, level: int = 
             if best.get("at_bound"):
                 txt += " Its best value sits on the bound of its range: treat it as a stand-in, not an explanation."
             doc.text(txt)
+    _detectability_part(doc, diag, level + 1)
     doc.heading("Adding it: the error ladder", level + 1)
     doc.table(["rung", "model", "RMSE", "bias", "largest |E|", "ΔBIC"],
               [[str(r["rung"]), lit(r["model"]), fmt(r["rmse_arcmin"], 4), fmt(r["bias_arcmin"], 4),

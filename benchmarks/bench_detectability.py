@@ -1,0 +1,111 @@
+"""Which noise does each candidate effect need to be found? Measured against predicted.
+
+For every candidate effect at its realistic value (and for no effect), the FE model makes
+the curves of N HD 42 specimens once (coarse test mesh, as in tests/test_hidden_effects.py);
+Gaussian noise of several levels, with several seeds, is added; each data set is diagnosed
+(one round). A row counts how often the effect was named (first, or among the
+indistinguishable), how often its parameter came back within 15 %, and whether the
+diagnosis's own detectability estimate (``diagnosis.json: detectability``) said this data
+could show the effect. The model tables (campaign model and every candidate's grid) are
+solved once and shared, as in a campaign.
+
+Usage: .venv/bin/python benchmarks/bench_detectability.py [--specimens 12] [--seeds 3]
+       [--noise-pct 2 0.5 0.2 0.1] [--out detectability.json]
+"""
+
+import argparse
+import json
+import statistics
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from hdwf.campaign import add_noise, plan_variants, solve_specimens, synth_curves, synth_designs
+from hdwf.diagnosis import diagnose
+from hdwf.effects import registry
+from hdwf.measurements import load_measurements
+
+UNIT = "hd42"
+DESIGN_SEED = 11
+SETTINGS = dict(elements_over_height=5, elements_over_thickness=3, refinement=1.0, symmetry="half")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--specimens", type=int, default=12)
+    parser.add_argument("--seeds", type=int, default=3)
+    parser.add_argument("--noise-pct", type=float, nargs="+", default=[2.0, 0.5, 0.2, 0.1],
+                        help="noise levels in %% of the mean lost motion of the specimens")
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--out", type=Path, help="write the rows as JSON here")
+    args = parser.parse_args()
+
+    t0 = time.perf_counter()
+    specimens = synth_designs(UNIT, args.specimens, DESIGN_SEED)
+    plan = plan_variants({})
+    tables = solve_specimens(UNIT, specimens, SETTINGS, 5, lambda _: plan, jobs=args.jobs)
+    base = tables[tables["variant"] == "baseline"]
+    signal = float(base.groupby("specimen_id")["twist_arcmin"].agg(lambda t: t.max() - t.min()).mean())
+    print(f"tables: {time.perf_counter() - t0:.0f} s; mean lost motion {signal:.3f} arcmin")
+
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="hdwf-detect-") as tmp:
+        for effect in [None, *sorted(registry())]:
+            hidden = {}
+            if effect:
+                p = registry()[effect].parameters[0]
+                hidden = {effect: {p.name: p.realistic}}
+            clean = synth_curves(UNIT, args.specimens, DESIGN_SEED, hidden, SETTINGS, jobs=args.jobs)
+            for pct in args.noise_pct:
+                noise = pct / 100 * signal
+                named = recovered = 0
+                predicted, errs, secs = [], [], []
+                for seed in range(1, args.seeds + 1):
+                    path = Path(tmp) / f"{effect}-{pct}-{seed}.csv"
+                    add_noise(clean, noise, seed).to_csv(path, index=False)
+                    t1 = time.perf_counter()
+                    diag, _ = diagnose(load_measurements(path), tables, max_rounds=1)
+                    secs.append(time.perf_counter() - t1)
+                    v = diag["verdict"]
+                    if effect is None:
+                        named += v["missing_effect"] is None        # "named" = rightly silent
+                        continue
+                    predicted.append(effect not in v["could_not_see"])
+                    if v["missing_effect"] == effect or effect in v["indistinguishable_from"]:
+                        named += 1
+                        est = next(r for r in diag["ranking"] if r["effect"] == effect)["params"][p.name]
+                        errs.append(abs(est / p.realistic - 1))
+                        recovered += errs[-1] <= 0.15
+                row = {"effect": effect or "none", "noise_pct": pct, "noise_arcmin": noise, "seeds": args.seeds,
+                       "named": named, "recovered_15pct": recovered if effect else None,
+                       "median_rel_error": statistics.median(errs) if errs else None,
+                       "predicted_visible": (sum(predicted) / len(predicted)) if predicted else None,
+                       "diagnose_s": statistics.median(secs)}
+                if effect:
+                    seen = next(c for c in diag["detectability"]["candidates"] if c["effect"] == effect)
+                    row.update(expected_rel_sd=seen["expected_rel_sd"], noise_to_show_arcmin=seen["noise_to_show_arcmin"],
+                               change_rms_arcmin=seen["change_rms_arcmin"])
+                rows.append(row)
+                print(json.dumps(row))
+
+    print(f"\nmean lost motion {signal:.3f} arcmin, {args.specimens} specimens, {args.seeds} seeds, "
+          f"total {time.perf_counter() - t0:.0f} s\n")
+    print("| effect | noise (% / arcmin) | predicted visible | named | within 15 % | expected rel. sd |")
+    print("|---|---|---|---|---|---|")
+    for r in rows:
+        vis = "–" if r["predicted_visible"] is None else f"{r['predicted_visible']:.0%}"
+        sd = "–" if r.get("expected_rel_sd") is None else f"{r['expected_rel_sd']:.0%}"
+        rec = "–" if r["recovered_15pct"] is None else f"{r['recovered_15pct']}/{r['seeds']}"
+        name = f"{r['named']}/{r['seeds']}" + (" silent" if r["effect"] == "none" else "")
+        print(f"| {r['effect']} | {r['noise_pct']:g} / {r['noise_arcmin']:.4f} | {vis} | {name} | {rec} | {sd} |")
+    if args.out:
+        tmp_out = args.out.with_suffix(args.out.suffix + ".tmp")
+        tmp_out.write_text(json.dumps({"signal_arcmin": signal, "rows": rows}, indent=1, default=float))
+        tmp_out.replace(args.out)
+
+
+if __name__ == "__main__":
+    np.seterr(all="ignore")
+    main()
