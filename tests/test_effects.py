@@ -43,8 +43,17 @@ def test_registry_has_five_documented_effects():
         assert eff.description and eff.signature and eff.parameters
         for p in eff.parameters:
             assert p.lower <= p.realistic <= p.upper and p.unit
+            assert all(p.lower <= v <= p.upper for _, v in p.realistic_by_unit)
         # at a realistic value the effect changes the model
         assert model_changes({eff.name: {p.name: p.realistic for p in eff.parameters}}) != ModelChanges()
+
+
+def test_cup_stiffness_scales_with_size_cubed():
+    """K = 2 pi G R^3 t / L with R, t, L in proportion to the drive: K(HD 120) / K(HD 42) =
+    (120/42)^3 (bearing outside diameters, paper Table 2)."""
+    p = registry()["fs_cup_torsion"].param("K_Nm_per_rad")
+    assert p.realistic_for("hd42") == p.realistic
+    assert p.realistic_for("hd120") / p.realistic_for("hd42") == pytest.approx((120 / 42) ** 3, rel=0.05)
 
 
 def test_bad_effect_settings_are_refused_with_names():

@@ -70,7 +70,8 @@ def _effects(args) -> int:
     for eff in registry().values():
         print(f"{eff.name}: {eff.title}{' (in series at the output)' if eff.series else ''}")
         for p in eff.parameters:
-            print(f"    {p.name} [{p.unit}] in [{p.lower:g}, {p.upper:g}], realistic {p.realistic:g}: {p.description}")
+            print(f"    {p.name} [{p.unit}] in [{p.lower:g}, {p.upper:g}], realistic {p.realistic:g}"
+                  + "".join(f" ({u}: {v:g})" for u, v in p.realistic_by_unit) + f": {p.description}")
         print(f"    signature: {eff.signature}")
     return 0
 

@@ -240,8 +240,10 @@ def loo_rmse(D, S0, resp, effects, fit: Fit, specimen: np.ndarray) -> float:
     return float(np.sqrt(np.mean(err ** 2)))
 
 
-def detectability(resp: dict[str, Response], noise: float, n: int, pay_threshold: float = 10.0) -> list[dict]:
-    """Could this data show each candidate at its realistic value? (see the module docstring)
+def detectability(resp: dict[str, Response], noise: float, n: int, unit: str | None = None,
+                  pay_threshold: float = 10.0) -> list[dict]:
+    """Could this data show each candidate at its realistic value for ``unit``? (see the
+    module docstring)
 
     ``noise`` is the standard deviation of one observation (arcmin), ``n`` their number.
     Returns one row per candidate: the change at the realistic value (RMS and largest, arcmin),
@@ -252,12 +254,13 @@ def detectability(resp: dict[str, Response], noise: float, n: int, pay_threshold
     rows = []
     for name, r in resp.items():
         p = get_effect(name).param(r.param)
-        delta = r.change(p.to_t(p.realistic))
+        realistic = p.realistic_for(unit)
+        delta = r.change(p.to_t(realistic))
         size = float(np.linalg.norm(delta))
         chi2 = (size / noise) ** 2 if noise > 0 else math.inf
         # the noise s that solves n ln(1 + size²/(n s²)) = need
         show = size / math.sqrt(n * math.expm1(need / n)) if size > 0 else 0.0
-        rows.append({"effect": name, "param": r.param, "realistic": p.realistic, "unit": p.unit,
+        rows.append({"effect": name, "param": r.param, "realistic": realistic, "unit": p.unit,
                      "change_rms_arcmin": size / math.sqrt(n), "change_max_arcmin": float(np.max(np.abs(delta))),
                      "expected_delta_bic": float(-n * math.log1p(chi2 / n) + math.log(n)) if math.isfinite(chi2)
                      else -math.inf,
@@ -354,7 +357,8 @@ def diagnose(meas, table: pd.DataFrame, fixed: dict | None = None, calibrate_fir
     else:
         sigma = float(np.sqrt(fit.rss / max(len(D) - len(on), 1)))
         sigma_from = "the residual of the final model (no noise stated: an upper bound on the noise)"
-    seen = detectability(resp, sigma, len(D), pay_threshold)
+    units = meas.units
+    seen = detectability(resp, sigma, len(D), units[0] if len(units) == 1 else None, pay_threshold)
     points = obs.copy()
     points["S_model"] = S0
     points["S_final"] = fit.S

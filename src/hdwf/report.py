@@ -474,10 +474,11 @@ def _detectability_part(doc: Document, diag: dict, level: int):
     rows = []
     for c in det["candidates"]:
         p = get_effect(c["effect"]).param(c["param"])
-        rows.append([lit(c["effect"]), f"{lit(p.name)} = {fmt(c['realistic'], 3)} {lit(p.unit)}",
+        sd = c["expected_rel_sd"]
+        rows.append([lit(c["effect"]), f"{c['realistic']:g} {lit(p.unit)}",
                      fmt(c["change_rms_arcmin"], 3), fmt(c["change_max_arcmin"], 3),
                      fmt(c["noise_to_show_arcmin"], 3), fmt(c["noise_to_calibrate_arcmin"], 3),
-                     fmt(c["expected_delta_bic"], 1), f"{fmt(100 * c['expected_rel_sd'], 2)} %",
+                     fmt(c["expected_delta_bic"], 1), "> 1000 %" if sd > 10 else f"{fmt(100 * sd, 2)} %",
                      "yes" if c["visible"] else "no"])
     doc.table(["effect", "realistic value", "change RMS", "change max", "noise to show", "noise to calibrate",
                "ΔBIC", "sd of parameter", "visible"], rows,
@@ -488,11 +489,15 @@ def _detectability_part(doc: Document, diag: dict, level: int):
               "were there at that value (linearised).")
     hidden = [c for c in det["candidates"] if not c["visible"]]
     if hidden:
-        doc.text("This data could not have shown " + ", ".join(
-            f"{lit(get_effect(c['effect']).title.lower())} (its change, {fmt(c['change_rms_arcmin'], 2)} arcmin RMS, "
-            f"needs noise below {fmt(c['noise_to_show_arcmin'], 2)} arcmin)" for c in hidden)
-            + ": a verdict without them is not evidence that they are absent. Less noise (averaged repeat runs, a "
-            "finer encoder) or more specimens would show them.")
+        doc.text("This data could not have shown these effects at realistic values, so its verdict says nothing "
+                 "about them (not finding them is no evidence that they are absent): " + "; ".join(
+            f"{lit(get_effect(c['effect']).title)} (it changes the predictions by {fmt(c['change_rms_arcmin'], 2)} "
+            f"arcmin RMS and needs noise below {fmt(c['noise_to_show_arcmin'], 2)} arcmin)" for c in hidden)
+            + (". Less noise (averaged repeat runs, a finer encoder) or more specimens would show them."
+               if diag.get("noise_arcmin") else
+               ". No noise is stated, so the final model's residual stands in for it; that residual also holds "
+               "whatever error the model cannot explain, and a large model error hides every candidate until it "
+               "is explained."))
 
 
 def _validation_section(doc: Document, campaign: str, files: dict, level: int = 2):

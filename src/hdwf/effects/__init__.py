@@ -35,6 +35,11 @@ class Parameter:
     description: str
     transform: str = "linear"  # "linear" or "reciprocal": response ~ linear in it, 0 = off
     grid_points: int = 4       # tabulated values besides "off" (for FE-level effects)
+    realistic_by_unit: tuple = ()   # ((unit, value), ...) where a drive's size changes it
+
+    def realistic_for(self, unit: str | None) -> float:
+        """The realistic value for one drive (``realistic`` unless the size changes it)."""
+        return dict(self.realistic_by_unit).get(unit, self.realistic)
 
     def to_t(self, value: float) -> float:
         return 1.0 / value if self.transform == "reciprocal" else float(value)

@@ -16,7 +16,9 @@ EFFECT = Effect(
     signature="extra twist proportional to the torque: a steeper curve, no dead band, no loop",
     parameters=(Parameter("K_Nm_per_rad", "N·m/rad", 1.0e3, 1.0e7, 6.0e4,
                           "torsional stiffness of cup and diaphragm (thin tube: 2 pi G R^3 t / L)",
-                          "reciprocal"),),
+                          "reciprocal",
+                          # R, t and L all grow with the drive: K ~ size^3, (120/42)^3 = 23.3
+                          realistic_by_unit=(("hd120", 1.4e6),)),),
     apply=lambda ch, K_Nm_per_rad: replace(
         ch, output_compliance_rad_per_Nmm=ch.output_compliance_rad_per_Nmm
         + 1.0 / (K_Nm_per_rad * 1000.0)),
