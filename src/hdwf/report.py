@@ -201,7 +201,7 @@ def _sobol_section(doc: Document, units, files, level: int = 1):
     doc.heading("Sobol' indices", level)
     doc.text("First-order $S_i$ and total-effect $S_(T i)$ indices of the surrogate over uniform inputs. Estimates: "
              "SALib's Saltelli/Jansen estimators on radial samples built from LHS, Halton and Sobol' base samples "
-             "of growing size $N$ (powers of two), with 95 % bootstrap intervals. The *exact* values come from "
+             "of growing size $N$ (powers of two), with 95 % bootstrap intervals at the last $N$. The *exact* values come from "
              "the Legendre expansion of the quadratic ($V_i = a_i^2\\/3 + 4 q_i^2\\/45$, $V_(i j) = r_(i j)^2\\/9$) "
              "and are what the estimates converge to.")
     for u in units:
