@@ -100,3 +100,31 @@ def test_detectability_of_a_linear_effect():
     assert row["noise_to_calibrate_arcmin"] == pytest.approx(0.075 * size)
     # twice the noise at which it just shows: no longer visible
     assert detectability(resp, noise=2 * s, n=200)[0]["visible"] is False
+
+
+def test_report_says_which_effects_the_data_could_not_show():
+    """The report's table and sentence come from diagnosis.json: a candidate the data could not
+    show is named with the noise it needs; a perfect fit (noise 0: sd null in the JSON) prints
+    a dash, not an error; a found effect is not listed as unseen."""
+    from hdwf.diagnosis import detectability, json_safe
+    from hdwf.report import Document, _detectability_part
+
+    g = np.linspace(-1.0, 1.0, 100)
+    resp = {"tooth_friction": _linear_response(g)}
+    rows = json_safe(detectability(resp, noise=1.0, n=100))
+    diag = {"noise_arcmin": 1.0, "verdict": {"could_not_see": ["tooth_friction"]},
+            "detectability": {"noise_arcmin": 1.0, "noise_from": "stated", "candidates": rows}}
+    doc = Document("t", "s", {})
+    _detectability_part(doc, diag, 2)
+    table = next(b for b in doc.blocks if b["type"] == "table")
+    assert table["rows"][0][-1] == "no"
+    sentence = doc.blocks[-1]["text"]
+    assert "Coulomb friction on the tooth flanks" in sentence
+    assert f"needs noise below {rows[0]['noise_to_show_arcmin']:.2f}" in sentence
+    rows0 = json_safe(detectability(resp, noise=0.0, n=100))
+    assert rows0[0]["expected_delta_bic"] is None and rows0[0]["visible"] is True
+    diag0 = {"noise_arcmin": 0.0, "verdict": {"could_not_see": []},
+             "detectability": {"noise_arcmin": 0.0, "noise_from": "stated", "candidates": rows0}}
+    doc0 = Document("t", "s", {})
+    _detectability_part(doc0, diag0, 2)
+    assert doc0.blocks[-1]["type"] == "table" and doc0.blocks[-1]["rows"][0][-1] == "yes"

@@ -378,7 +378,8 @@ def diagnose(meas, table: pd.DataFrame, fixed: dict | None = None, calibrate_fir
         "ranking": first["ranking"],
         "verdict": {**first["verdict"],
                     "found_in_order": [f["effect"] for f in found if f["effect"] not in calibrate_first],
-                    "could_not_see": [r["effect"] for r in seen if not r["visible"]]},
+                    # not found, and not visible at a realistic value: the verdict is silent on them
+                    "could_not_see": [r["effect"] for r in seen if not r["visible"] and r["effect"] not in on]},
         "detectability": {"noise_arcmin": sigma, "noise_from": sigma_from, "pay_threshold": pay_threshold,
                           "candidates": seen},
         "rounds": rounds,

@@ -478,7 +478,8 @@ def _detectability_part(doc: Document, diag: dict, level: int):
         rows.append([lit(c["effect"]), f"{c['realistic']:g} {lit(p.unit)}",
                      fmt(c["change_rms_arcmin"], 3), fmt(c["change_max_arcmin"], 3),
                      fmt(c["noise_to_show_arcmin"], 3), fmt(c["noise_to_calibrate_arcmin"], 3),
-                     fmt(c["expected_delta_bic"], 1), "> 1000 %" if sd > 10 else f"{fmt(100 * sd, 2)} %",
+                     fmt(c["expected_delta_bic"], 1),
+                     "–" if sd is None else "> 1000 %" if sd > 10 else f"{fmt(100 * sd, 2)} %",
                      "yes" if c["visible"] else "no"])
     doc.table(["effect", "realistic value", "change RMS", "change max", "noise to show", "noise to calibrate",
                "ΔBIC", "sd of parameter", "visible"], rows,
@@ -487,7 +488,7 @@ def _detectability_part(doc: Document, diag: dict, level: int):
               "largest noise at which it would still pay (ΔBIC ≤ −10); noise to calibrate: at which its parameter would "
               "come out within 15 % (two standard deviations). ΔBIC and sd: what this data would give if the effect "
               "were there at that value (linearised).")
-    hidden = [c for c in det["candidates"] if not c["visible"]]
+    hidden = [c for c in det["candidates"] if c["effect"] in diag["verdict"].get("could_not_see", [])]
     if hidden:
         doc.text("This data could not have shown these effects at realistic values, so its verdict says nothing "
                  "about them (not finding them is no evidence that they are absent): " + "; ".join(
