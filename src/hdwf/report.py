@@ -512,7 +512,8 @@ def _validation_section(doc: Document, campaign: str, files: dict, level: int = 
              f"({lit(diag['form'])} form)" + (f", stated noise {fmt(noise, 4)} arcmin" if noise else ", no noise stated")
              + f". Model: our FE model on a mesh of {diag['mesh']['elements_over_height']} × "
              f"{diag['mesh']['elements_over_thickness']} elements per tooth"
-             + (f", with {lit(', '.join(diag['model']['fixed']))} switched on" if diag["model"]["fixed"] else "") + ".")
+             + (f", with {lit(', '.join(diag['model']['fixed']))} switched on" if diag["model"]["fixed"] else "") + ". "
+             + f"Candidates tried: {lit(', '.join(sorted(r['effect'] for r in diag['ranking'])))}.")
     doc.heading("Where the model fails", level + 1)
     rows = [["RMSE", fmt(b["rmse_arcmin"], 4)], ["bias (mean S − D)", fmt(b["bias_arcmin"], 4)],
             ["largest |E|", fmt(b["max_abs_arcmin"], 4)], ["worst specimen", lit(b["worst_specimen"])]]
