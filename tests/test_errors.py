@@ -86,3 +86,19 @@ def test_table_empty_cell(tmp_path):
     f.write_text("\n".join(lines) + "\n")
     with pytest.raises(InputError, match=r"row 2, field 'Gr_mm'"):
         load_fea_designs(d, "hd120")
+
+
+def test_plan_command_refuses_bad_input_before_solving(tmp_path, capsys):
+    """`hdwf plan`: an existing --out file is kept (no --force), a noise <= 0 is named; both
+    are refused before any solve."""
+    from hdwf.cli import main
+
+    out = tmp_path / "plan.json"
+    out.write_text("keep me")
+    rc = main(["plan", "--unit", "hd42", "--designs", "3", "--seed", "1", "--noise-arcmin", "0.05",
+               "--out", str(out)])
+    assert rc == 2 and out.read_text() == "keep me"
+    assert "--out" in capsys.readouterr().err
+    rc = main(["plan", "--unit", "hd42", "--designs", "3", "--seed", "1", "--noise-arcmin", "0"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "noise_arcmin" in err and "0" in err

@@ -76,6 +76,40 @@ def _effects(args) -> int:
     return 0
 
 
+def _plan(args) -> int:
+    from .campaign import synth_designs
+    from .diagnosis import json_safe, plan_detectability
+    from .io import atomic_path
+
+    out = Path(args.out) if args.out else None
+    if out is not None and out.exists() and not args.force:
+        raise InputError(out, "exists; use --force to replace it", field="--out")
+    settings = {"elements_over_height": args.elements_over_height,
+                "elements_over_thickness": args.elements_over_thickness,
+                "refinement": args.refinement, "symmetry": "half"}
+    try:
+        specimens = synth_designs(args.unit, args.designs, args.seed)
+        plan = plan_detectability(args.unit, specimens, settings, args.steps_per_ramp, args.noise_arcmin,
+                                  jobs=args.jobs)
+    except ValueError as exc:
+        raise InputError("command line", str(exc)) from None
+    print(f"{plan['n_specimens']} specimens of {args.unit} (mean lost motion {plan['mean_lost_motion_arcmin']:.3f} "
+          f"arcmin), {plan['n_points']} points, noise {args.noise_arcmin:g} arcmin per point:")
+    print(f"  {'effect':<16} {'realistic':>12} {'change RMS':>11} {'noise to show':>14} {'to calibrate':>13} "
+          f"{'sd':>7}  visible")
+    for c in plan["candidates"]:
+        sd = c["expected_rel_sd"]
+        print(f"  {c['effect']:<16} {c['realistic']:>12.4g} {c['change_rms_arcmin']:>11.4f} "
+              f"{c['noise_to_show_arcmin']:>14.4f} {c['noise_to_calibrate_arcmin']:>13.4f} "
+              f"{(f'{100 * sd:.0f} %' if sd < 10 else '>1000 %'):>7}  {'yes' if c['visible'] else 'no'}")
+    print("  (arcmin; noise to show: ΔBIC -10; to calibrate: parameter within 15 % at two sd)")
+    if out is not None:
+        with atomic_path(out) as tmp:
+            Path(tmp).write_text(json.dumps(json_safe(plan), indent=1))
+        print(f"{out}: written")
+    return 0
+
+
 def _paper_measurements(args) -> int:
     from .io import atomic_path
     from .paper import paper_measurements
@@ -126,6 +160,23 @@ def main(argv=None) -> int:
     p.add_argument("--steps-per-ramp", type=int, default=5)
     p.add_argument("--jobs", type=int, default=1, help="processes (one specimen each)")
     p.set_defaults(func=_synth)
+    p = sub.add_parser("plan", help="before measuring: which effects could a test show at a given noise",
+                       description="Solves the model and every candidate's grid at N Latin-hypercube "
+                                   "specimens (as a campaign would) and prints, per candidate at its "
+                                   "realistic value, the change it makes and whether a test with this noise "
+                                   "per point could show it (docs/validation.md).")
+    p.add_argument("--unit", required=True, choices=["hd42", "hd120"])
+    p.add_argument("--designs", type=int, required=True, help="number of specimens")
+    p.add_argument("--seed", type=int, required=True, help="seed of the designs")
+    p.add_argument("--noise-arcmin", type=float, required=True, help="standard deviation of one reading")
+    p.add_argument("--out", help="also write the table as JSON here (never overwritten)")
+    p.add_argument("--force", action="store_true", help="replace an existing output file")
+    p.add_argument("--elements-over-height", type=int, default=5)
+    p.add_argument("--elements-over-thickness", type=int, default=3)
+    p.add_argument("--refinement", type=float, default=1.0)
+    p.add_argument("--steps-per-ramp", type=int, default=5)
+    p.add_argument("--jobs", type=int, default=1, help="processes (one specimen each)")
+    p.set_defaults(func=_plan)
     args = parser.parse_args(argv)
     try:
         return args.func(args)

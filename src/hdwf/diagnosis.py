@@ -270,6 +270,43 @@ def detectability(resp: dict[str, Response], noise: float, n: int, unit: str | N
     return rows
 
 
+def plan_detectability(unit: str, specimens: pd.DataFrame, settings: dict, steps_per_ramp: int,
+                       noise_arcmin: float, candidates: list[str] | None = None, jobs: int = 1,
+                       pay_threshold: float = 10.0) -> dict:
+    """Before measuring: which candidates could a test of these specimens show at this noise?
+
+    Solves the campaign tables of ``specimens`` (the baseline model and every candidate's
+    grid, as a campaign would) and evaluates ``detectability`` on the curve form of the
+    test (every step of every specimen) with ``noise_arcmin`` per point."""
+    from .campaign import candidate_names, plan_variants, solve_specimens
+
+    if not (noise_arcmin > 0 and math.isfinite(noise_arcmin)):
+        raise ValueError(f"noise_arcmin must be > 0, got {noise_arcmin!r}")
+    candidates = candidate_names({}) if candidates is None else list(candidates)
+    plan = plan_variants({}, candidates)
+    table = solve_specimens(unit, specimens, settings, steps_per_ramp, lambda _: plan, jobs)
+    return detectability_of_tables(table, unit, noise_arcmin, candidates, pay_threshold)
+
+
+def detectability_of_tables(table: pd.DataFrame, unit: str, noise_arcmin: float,
+                            candidates: list[str], pay_threshold: float = 10.0) -> dict:
+    """``plan_detectability`` on tables already solved (every step of every specimen observed)."""
+    base = table[table["variant"] == variant_key({})]
+    bad = base[base["status"] != "ok"]
+    if len(bad):
+        raise RuntimeError(f"the baseline solve failed for specimen {bad['specimen_id'].iloc[0]}: "
+                           f"{bad['status'].iloc[0]}")
+    obs = base[["specimen_id", "step", "torque_Nm"]].reset_index(drop=True)
+    obs["quantity"] = "twist"
+    notes: dict[str, str] = {}
+    resp = responses(table, obs, {}, candidates, notes)
+    lost_motion = base.groupby("specimen_id")["twist_arcmin"].agg(lambda t: t.max() - t.min())
+    return {"unit": unit, "n_specimens": int(base["specimen_id"].nunique()), "n_points": int(len(obs)),
+            "noise_arcmin": float(noise_arcmin), "mean_lost_motion_arcmin": float(lost_motion.mean()),
+            "pay_threshold": pay_threshold, "notes": notes,
+            "candidates": detectability(resp, noise_arcmin, len(obs), unit, pay_threshold)}
+
+
 def _cosine(a: np.ndarray, b: np.ndarray) -> float:
     na, nb = np.linalg.norm(a), np.linalg.norm(b)
     return float(a @ b / (na * nb)) if na > 0 and nb > 0 else 0.0
