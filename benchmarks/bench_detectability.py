@@ -25,6 +25,7 @@ import numpy as np
 from hdwf.campaign import add_noise, plan_variants, solve_specimens, synth_curves, synth_designs
 from hdwf.diagnosis import diagnose
 from hdwf.effects import registry
+from hdwf.io import atomic_path
 from hdwf.measurements import load_measurements
 
 UNIT = "hd42"
@@ -101,9 +102,8 @@ def main():
         name = f"{r['named']}/{r['seeds']}" + (" silent" if r["effect"] == "none" else "")
         print(f"| {r['effect']} | {r['noise_pct']:g} / {r['noise_arcmin']:.4f} | {vis} | {name} | {rec} | {sd} |")
     if args.out:
-        tmp_out = args.out.with_suffix(args.out.suffix + ".tmp")
-        tmp_out.write_text(json.dumps({"signal_arcmin": signal, "rows": rows}, indent=1, default=float))
-        tmp_out.replace(args.out)
+        with atomic_path(args.out) as tmp_out:
+            tmp_out.write_text(json.dumps({"signal_arcmin": signal, "rows": rows}, indent=1, default=float))
 
 
 if __name__ == "__main__":

@@ -27,6 +27,34 @@ def _provenance(args) -> int:
     return 0
 
 
+def _refuse_existing(out: Path, args, why: str = "") -> None:
+    """An existing output file is kept unless --force says otherwise."""
+    if out.exists() and not args.force:
+        raise InputError(out, f"exists; {why}use --force to replace it", field="--out")
+
+
+def _mesh_settings(args) -> dict:
+    """FE mesh settings of the synth/plan solves (half model) from their options."""
+    return {"elements_over_height": args.elements_over_height,
+            "elements_over_thickness": args.elements_over_thickness,
+            "refinement": args.refinement, "symmetry": "half"}
+
+
+def _specimen_options(p, seed_help: str, noise_help: str) -> None:
+    p.add_argument("--unit", required=True, choices=["hd42", "hd120"])
+    p.add_argument("--designs", type=int, required=True, help="number of specimens")
+    p.add_argument("--seed", type=int, required=True, help=seed_help)
+    p.add_argument("--noise-arcmin", type=float, required=True, help=noise_help)
+
+
+def _solve_options(p, elements_over_height: int, elements_over_thickness: int) -> None:
+    p.add_argument("--elements-over-height", type=int, default=elements_over_height)
+    p.add_argument("--elements-over-thickness", type=int, default=elements_over_thickness)
+    p.add_argument("--refinement", type=float, default=1.0)
+    p.add_argument("--steps-per-ramp", type=int, default=5)
+    p.add_argument("--jobs", type=int, default=1, help="processes (one specimen each)")
+
+
 def _synth(args) -> int:
     from .campaign import synthesize
     from .effects import parse_assignment
@@ -35,9 +63,7 @@ def _synth(args) -> int:
     out = Path(args.out)
     if out.suffix.lower() not in (".csv", ".parquet"):
         raise InputError(out, f"unknown file type '{out.suffix}': write .csv or .parquet", field="--out")
-    if out.exists() and not args.force:
-        raise InputError(out, "exists; measurement files are never overwritten (use --force to replace it)",
-                         field="--out")
+    _refuse_existing(out, args, "measurement files are never overwritten: ")
     effects: dict[str, dict[str, float]] = {}
     for text in args.effect:
         try:
@@ -45,11 +71,8 @@ def _synth(args) -> int:
         except (KeyError, ValueError) as exc:
             raise InputError("command line", str(exc).strip("'\""), field="--effect", value=text) from None
         effects.setdefault(name, {})[pname] = value
-    settings = {"elements_over_height": args.elements_over_height,
-                "elements_over_thickness": args.elements_over_thickness,
-                "refinement": args.refinement, "symmetry": "half"}
     try:
-        data = synthesize(args.unit, args.designs, args.seed, args.noise_arcmin, effects, settings,
+        data = synthesize(args.unit, args.designs, args.seed, args.noise_arcmin, effects, _mesh_settings(args),
                           steps_per_ramp=args.steps_per_ramp, jobs=args.jobs)
     except ValueError as exc:
         raise InputError("command line", str(exc)) from None
@@ -82,15 +105,12 @@ def _plan(args) -> int:
     from .io import atomic_path
 
     out = Path(args.out) if args.out else None
-    if out is not None and out.exists() and not args.force:
-        raise InputError(out, "exists; use --force to replace it", field="--out")
-    settings = {"elements_over_height": args.elements_over_height,
-                "elements_over_thickness": args.elements_over_thickness,
-                "refinement": args.refinement, "symmetry": "half"}
+    if out is not None:
+        _refuse_existing(out, args)
     try:
         specimens = synth_designs(args.unit, args.designs, args.seed)
-        plan = plan_detectability(args.unit, specimens, settings, args.steps_per_ramp, args.noise_arcmin,
-                                  jobs=args.jobs)
+        plan = plan_detectability(args.unit, specimens, _mesh_settings(args), args.steps_per_ramp,
+                                  args.noise_arcmin, jobs=args.jobs)
     except ValueError as exc:
         raise InputError("command line", str(exc)) from None
     print(f"{plan['n_specimens']} specimens of {args.unit} (mean lost motion {plan['mean_lost_motion_arcmin']:.3f} "
@@ -115,9 +135,7 @@ def _paper_measurements(args) -> int:
     from .paper import paper_measurements
 
     out = Path(args.out)
-    if out.exists() and not args.force:
-        raise InputError(out, "exists; measurement files are never overwritten (use --force to replace it)",
-                         field="--out")
+    _refuse_existing(out, args, "measurement files are never overwritten: ")
     data = paper_measurements(args.data, args.unit)
     with atomic_path(out) as tmp:
         data.to_csv(tmp, index=False, float_format="%.10g")
@@ -146,36 +164,22 @@ def main(argv=None) -> int:
                        description="Synthetic measurements (curve form of docs/measurements.md) from the FE "
                                    "model at N Latin-hypercube specimens, with effects switched on and "
                                    "Gaussian noise added.")
-    p.add_argument("--unit", required=True, choices=["hd42", "hd120"])
-    p.add_argument("--designs", type=int, required=True, help="number of specimens")
-    p.add_argument("--seed", type=int, required=True, help="seed of the designs and the noise")
-    p.add_argument("--noise-arcmin", type=float, required=True, help="standard deviation of the noise")
+    _specimen_options(p, "seed of the designs and the noise", "standard deviation of the noise")
     p.add_argument("--effect", action="append", default=[], metavar="NAME:PARAM=VALUE",
                    help="switch an effect on, e.g. tooth_friction:mu=0.08 (repeatable)")
     p.add_argument("--out", required=True, help="output file, .csv or .parquet (never overwritten)")
     p.add_argument("--force", action="store_true", help="replace an existing output file")
-    p.add_argument("--elements-over-height", type=int, default=10)
-    p.add_argument("--elements-over-thickness", type=int, default=6)
-    p.add_argument("--refinement", type=float, default=1.0)
-    p.add_argument("--steps-per-ramp", type=int, default=5)
-    p.add_argument("--jobs", type=int, default=1, help="processes (one specimen each)")
+    _solve_options(p, 10, 6)                 # the study's default mesh
     p.set_defaults(func=_synth)
     p = sub.add_parser("plan", help="before measuring: which effects could a test show at a given noise",
                        description="Solves the model and every candidate's grid at N Latin-hypercube "
                                    "specimens (as a campaign would) and prints, per candidate at its "
                                    "realistic value, the change it makes and whether a test with this noise "
                                    "per point could show it (docs/validation.md).")
-    p.add_argument("--unit", required=True, choices=["hd42", "hd120"])
-    p.add_argument("--designs", type=int, required=True, help="number of specimens")
-    p.add_argument("--seed", type=int, required=True, help="seed of the designs")
-    p.add_argument("--noise-arcmin", type=float, required=True, help="standard deviation of one reading")
+    _specimen_options(p, "seed of the designs", "standard deviation of one reading")
     p.add_argument("--out", help="also write the table as JSON here (never overwritten)")
     p.add_argument("--force", action="store_true", help="replace an existing output file")
-    p.add_argument("--elements-over-height", type=int, default=5)
-    p.add_argument("--elements-over-thickness", type=int, default=3)
-    p.add_argument("--refinement", type=float, default=1.0)
-    p.add_argument("--steps-per-ramp", type=int, default=5)
-    p.add_argument("--jobs", type=int, default=1, help="processes (one specimen each)")
+    _solve_options(p, 5, 3)                  # the campaigns' coarse mesh
     p.set_defaults(func=_plan)
     args = parser.parse_args(argv)
     try:

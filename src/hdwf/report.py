@@ -473,9 +473,8 @@ def _detectability_part(doc: Document, diag: dict, level: int):
     doc.heading("What this data could show", level)
     rows = []
     for c in det["candidates"]:
-        p = get_effect(c["effect"]).param(c["param"])
         sd = c["expected_rel_sd"]
-        rows.append([lit(c["effect"]), f"{c['realistic']:g} {lit(p.unit)}",
+        rows.append([lit(c["effect"]), f"{c['realistic']:g} {lit(c['unit'])}",
                      fmt(c["change_rms_arcmin"], 3), fmt(c["change_max_arcmin"], 3),
                      fmt(c["noise_to_show_arcmin"], 3), fmt(c["noise_to_calibrate_arcmin"], 3),
                      fmt(c["expected_delta_bic"], 1),
