@@ -10,7 +10,7 @@ could show the effect. The model tables (campaign model and every candidate's gr
 solved once and shared, as in a campaign.
 
 Usage: .venv/bin/python benchmarks/bench_detectability.py [--specimens 12] [--seeds 3]
-       [--noise-pct 2 0.5 0.2 0.1] [--out detectability.json]
+       [--noise-pct 2 0.5 0.2 0.1] [--steps-per-ramp 5] [--out detectability.json]
 """
 
 import argparse
@@ -39,6 +39,8 @@ def main():
     parser.add_argument("--seeds", type=int, default=3)
     parser.add_argument("--noise-pct", type=float, nargs="+", default=[2.0, 0.5, 0.2, 0.1],
                         help="noise levels in %% of the mean lost motion of the specimens")
+    parser.add_argument("--steps-per-ramp", type=int, default=5,
+                        help="points per curve = 4 x this + 1")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--out", type=Path, help="write the rows as JSON here")
     args = parser.parse_args()
@@ -46,7 +48,7 @@ def main():
     t0 = time.perf_counter()
     specimens = synth_designs(UNIT, args.specimens, DESIGN_SEED)
     plan = plan_variants({})
-    tables = solve_specimens(UNIT, specimens, SETTINGS, 5, lambda _: plan, jobs=args.jobs)
+    tables = solve_specimens(UNIT, specimens, SETTINGS, args.steps_per_ramp, lambda _: plan, jobs=args.jobs)
     base = tables[tables["variant"] == "baseline"]
     signal = float(base.groupby("specimen_id")["twist_arcmin"].agg(lambda t: t.max() - t.min()).mean())
     print(f"tables: {time.perf_counter() - t0:.0f} s; mean lost motion {signal:.3f} arcmin")
@@ -58,7 +60,8 @@ def main():
             if effect:
                 p = registry()[effect].parameters[0]
                 hidden = {effect: {p.name: p.realistic}}
-            clean = synth_curves(UNIT, args.specimens, DESIGN_SEED, hidden, SETTINGS, jobs=args.jobs)
+            clean = synth_curves(UNIT, args.specimens, DESIGN_SEED, hidden, SETTINGS, args.steps_per_ramp,
+                                 jobs=args.jobs)
             for pct in args.noise_pct:
                 noise = pct / 100 * signal
                 named = recovered = 0
@@ -91,7 +94,8 @@ def main():
                 rows.append(row)
                 print(json.dumps(row))
 
-    print(f"\nmean lost motion {signal:.3f} arcmin, {args.specimens} specimens, {args.seeds} seeds, "
+    print(f"\nmean lost motion {signal:.3f} arcmin, {args.specimens} specimens of "
+          f"{4 * args.steps_per_ramp + 1} points, {args.seeds} seeds, "
           f"total {time.perf_counter() - t0:.0f} s\n")
     print("| effect | noise (% / arcmin) | predicted visible | named | within 15 % | expected rel. sd |")
     print("|---|---|---|---|---|---|")
@@ -103,7 +107,8 @@ def main():
         print(f"| {r['effect']} | {r['noise_pct']:g} / {r['noise_arcmin']:.4f} | {vis} | {name} | {rec} | {sd} |")
     if args.out:
         with atomic_path(args.out) as tmp_out:
-            tmp_out.write_text(json.dumps({"signal_arcmin": signal, "rows": rows}, indent=1, default=float))
+            tmp_out.write_text(json.dumps({"signal_arcmin": signal, "steps_per_ramp": args.steps_per_ramp,
+                                           "rows": rows}, indent=1, default=float))
 
 
 if __name__ == "__main__":

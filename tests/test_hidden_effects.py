@@ -7,15 +7,22 @@ specimens. The model tables (campaign model + every candidate's grid) depend on 
 only, so they are solved once for the module and shared by every test.
 
 Noise levels. Our 2D model's lost motion is dominated by its dead band (about 9 arcmin on
-this mesh, docs/fe-model.md), so noise of 2 % of the lost motion (0.18 arcmin per point)
-hides every elastic effect at a realistic value: cup torsion and housing compliance change
-the twist at ±T by about 0.05 and 0.02 arcmin, friction by 0.01. The dead-band effects
-(thermal, Oldham play) are tested at 2 % of the signal, as the issue asks; every effect is
-also tested at bench-like noise of 0.2 % of the signal (about 1 arcsec, an encoder's
-resolution). Flank friction is not identifiable even there (it changes the curves by 0.0035
-arcmin RMS; it is found from 0.1 %, benchmarks/bench_detectability.py); that test is marked
-xfail with the measured reason rather than weakened, and the diagnosis must say it could not
-see it.
+this mesh, docs/fe-model.md), so noise of 2 % of the lost motion is 0.18 arcmin per point,
+while cup torsion and housing compliance at realistic values change the twist at ±T by
+about 0.05 and 0.02 arcmin (0.032 and 0.014 arcmin RMS over a curve), friction by 0.01.
+What data can show grows with the number of independent points: the parameter's relative
+sd is σ/|Δ|, |Δ| the norm of the change over all points (diagnosis.detectability).
+
+* Curves of 21 points (5 steps per ramp): the dead-band effects (thermal, Oldham play) are
+  found at 2 % noise; at 2 % the elastic ones are rightly not claimed; housing compliance
+  and friction are also tested at bench-like noise of 0.2 % (about 1 arcsec, an encoder's
+  resolution), where housing is recovered within 15 %.
+* Curves of 401 points (100 steps per ramp, a bench logging continuously): cup torsion is
+  found and recovered at 2 % noise, housing compliance is named (its k has an expected sd of
+  24 % there), and two hidden effects (temperature, cup) are found in two rounds.
+* Flank friction changes the curves by 0.0035 arcmin RMS: at 2 % noise it would need some
+  10^5 points. At 0.2 % on 21-point curves its test is marked xfail with the measured reason
+  rather than weakened, and the diagnosis must say it could not see it.
 """
 
 from __future__ import annotations
@@ -34,6 +41,8 @@ N_SPECIMENS = 12
 SEED = 11
 SETTINGS = dict(elements_over_height=5, elements_over_thickness=3, refinement=1.0, symmetry="half")
 JOBS = 2
+STEPS = 5           # per ramp: 21 points per curve
+DENSE_STEPS = 100   # 401 points per curve
 
 REALISTIC = {
     "thermal": ("delta_T_K", 12.0),      # between grid values (every 10 K)
@@ -52,7 +61,13 @@ def specimens():
 @pytest.fixture(scope="module")
 def tables(specimens):
     plan = plan_variants({})
-    return solve_specimens(UNIT, specimens, SETTINGS, 5, lambda _: plan, jobs=JOBS)
+    return solve_specimens(UNIT, specimens, SETTINGS, STEPS, lambda _: plan, jobs=JOBS)
+
+
+@pytest.fixture(scope="module")
+def dense_tables(specimens):
+    plan = plan_variants({})
+    return solve_specimens(UNIT, specimens, SETTINGS, DENSE_STEPS, lambda _: plan, jobs=JOBS)
 
 
 @pytest.fixture(scope="module")
@@ -62,9 +77,9 @@ def signal(tables):
     return float(base.groupby("specimen_id")["twist_arcmin"].agg(lambda t: t.max() - t.min()).mean())
 
 
-def _measure(tmp_path, specimens, effects, noise, seed=5):
+def _measure(tmp_path, specimens, effects, noise, steps=STEPS):
     """``hdwf synth`` in-process: same specimens as the tables, the hidden effects on."""
-    data = synthesize(UNIT, N_SPECIMENS, SEED, noise, effects, SETTINGS, jobs=JOBS)
+    data = synthesize(UNIT, N_SPECIMENS, SEED, noise, effects, SETTINGS, steps_per_ramp=steps, jobs=JOBS)
     # the synthesiser draws the same Latin hypercube: the specimens must be the tables' ones
     pd.testing.assert_frame_equal(data.drop_duplicates("specimen_id")[specimens.columns].reset_index(drop=True),
                                   specimens.reset_index(drop=True))
@@ -73,32 +88,32 @@ def _measure(tmp_path, specimens, effects, noise, seed=5):
     return load_measurements(path)
 
 
-def _rmse_switched_on(meas, specimens, effects):
+def _rmse_switched_on(meas, specimens, effects, steps=STEPS):
     """RMSE of the model with the calibrated effects switched on: actual solves, not the tables."""
-    table = solve_specimens(UNIT, specimens, SETTINGS, 5, lambda _: [effects], jobs=JOBS)
+    table = solve_specimens(UNIT, specimens, SETTINGS, steps, lambda _: [effects], jobs=JOBS)
     pred = table[["specimen_id", "step", "twist_arcmin"]].rename(columns={"twist_arcmin": "S"})
     pts = meas.data.merge(pred, on=["specimen_id", "step"])
     return float(np.sqrt(np.mean((pts["S"] - pts["twist_arcmin"]) ** 2)))
 
 
-def _check_found(diag, effect, param, true, meas, specimens, noise):
+def _check_found(diag, effect, param, true, meas, specimens, noise, steps=STEPS):
     verdict = diag["verdict"]
     named = verdict["missing_effect"] == effect or effect in verdict["indistinguishable_from"]
     assert named, verdict
     entry = next(r for r in diag["ranking"] if r["effect"] == effect)
     est = entry["params"][param]
     assert est == pytest.approx(true, rel=0.15), (effect, est, true)
-    rmse = _rmse_switched_on(meas, specimens, {effect: {param: est}})
+    rmse = _rmse_switched_on(meas, specimens, {effect: {param: est}}, steps)
     assert rmse <= 1.3 * noise, (effect, rmse, noise)
 
 
-def _hidden_one(tmp_path, specimens, tables, effect, noise):
+def _hidden_one(tmp_path, specimens, tables, effect, noise, steps=STEPS):
     param, true = REALISTIC[effect]
-    meas = _measure(tmp_path, specimens, {effect: {param: true}}, noise)
+    meas = _measure(tmp_path, specimens, {effect: {param: true}}, noise, steps)
     diag, _ = diagnose(meas, tables)
     # the diagnosis's own estimate agrees: this data can show the effect
     assert effect not in diag["verdict"]["could_not_see"], diag["detectability"]
-    _check_found(diag, effect, param, true, meas, specimens, noise)
+    _check_found(diag, effect, param, true, meas, specimens, noise, steps)
 
 
 @pytest.mark.parametrize("effect", ["thermal", "oldham_play"])
@@ -106,13 +121,39 @@ def test_dead_band_effect_found_at_two_percent_noise(tmp_path, specimens, tables
     _hidden_one(tmp_path, specimens, tables, effect, 0.02 * signal)
 
 
-@pytest.mark.parametrize("effect", ["thermal", "oldham_play", "fs_cup_torsion", "cs_housing",
+def test_cup_torsion_found_at_two_percent_noise_on_dense_curves(tmp_path, specimens, dense_tables, signal):
+    _hidden_one(tmp_path, specimens, dense_tables, "fs_cup_torsion", 0.02 * signal, DENSE_STEPS)
+
+
+def test_housing_named_at_two_percent_noise_on_dense_curves(tmp_path, specimens, dense_tables, signal):
+    """Housing compliance at 5e3 N/mm² changes these 401-point curves by 0.014 arcmin RMS:
+    at 2 % noise that pays (expected ΔBIC -21) but k comes out with an expected relative sd
+    of σ/(0.75 |Δ|) = 24 % — within 15 % needs about ten times the points. So: named, error
+    down to the noise, and the stated uncertainty is honest (truth within 2 sd of the
+    estimate); its 15 % recovery is tested at 0.2 % noise below."""
+    noise = 0.02 * signal
+    param, true = REALISTIC["cs_housing"]
+    meas = _measure(tmp_path, specimens, {"cs_housing": {param: true}}, noise, DENSE_STEPS)
+    diag, _ = diagnose(meas, dense_tables)
+    verdict = diag["verdict"]
+    assert "cs_housing" in [verdict["missing_effect"], *verdict["indistinguishable_from"]], verdict
+    row = next(c for c in diag["detectability"]["candidates"] if c["effect"] == "cs_housing")
+    assert row["visible"] and row["expected_rel_sd"] == pytest.approx(0.24, abs=0.03)
+    entry = next(r for r in diag["ranking"] if r["effect"] == "cs_housing")
+    est, sd = entry["params"][param], entry["param_sd"]
+    assert abs(est - true) <= 2 * sd, (est, sd)
+    assert _rmse_switched_on(meas, specimens, {"cs_housing": {param: est}}, DENSE_STEPS) <= 1.3 * noise
+
+
+@pytest.mark.parametrize("effect", ["cs_housing",
                                     pytest.param("tooth_friction", marks=pytest.mark.xfail(
                                         strict=True, reason="flank friction at mu 0.08 changes the curves by 0.0035 "
                                         "arcmin RMS in our 2D model: at 0.2 % noise mu has an expected sd of 33 % "
                                         "(this seed: 0.0925, 16 % off); it needs noise below 0.1 % of the signal, "
                                         "bench_detectability.py"))])
 def test_effect_found_at_bench_noise(tmp_path, specimens, tables, signal, effect):
+    """Bench-like noise, 0.2 % of the signal, on 21-point curves (the effects found at 2 %
+    above are not repeated here)."""
     _hidden_one(tmp_path, specimens, tables, effect, 0.002 * signal)
 
 
@@ -136,13 +177,12 @@ def test_elastic_effects_are_not_claimed_below_the_noise(tmp_path, specimens, ta
     assert not {"thermal", "oldham_play"} & set(diag["verdict"]["could_not_see"])
 
 
-def test_two_hidden_effects_found_in_two_rounds(tmp_path, specimens, tables, signal):
-    """Noise of 1 % of the signal: the least at which cup torsion at its realistic value pays
-    (bench_detectability.py)."""
+def test_two_hidden_effects_found_in_two_rounds(tmp_path, specimens, dense_tables, signal):
+    """Noise of 2 % of the signal on 401-point curves: a temperature difference and cup torsion."""
     hidden = {"thermal": {"delta_T_K": 12.0}, "fs_cup_torsion": {"K_Nm_per_rad": 6.0e4}}
-    noise = 0.01 * signal
-    meas = _measure(tmp_path, specimens, hidden, noise)
-    diag, _ = diagnose(meas, tables)
+    noise = 0.02 * signal
+    meas = _measure(tmp_path, specimens, hidden, noise, DENSE_STEPS)
+    diag, _ = diagnose(meas, dense_tables)
     found = diag["verdict"]["found_in_order"]
     rounds = diag["rounds"]
     assert len(found) == 2 and found[0] == "thermal", found
@@ -151,8 +191,9 @@ def test_two_hidden_effects_found_in_two_rounds(tmp_path, specimens, tables, sig
     assert "fs_cup_torsion" in [second["missing_effect"], *second["indistinguishable_from"]], second
     final = diag["final"]["effects"]
     assert final["thermal"]["delta_T_K"] == pytest.approx(12.0, rel=0.15)
+    assert final["fs_cup_torsion"]["K_Nm_per_rad"] == pytest.approx(6.0e4, rel=0.15)
     # both switched on at their calibrated values, actual solves: the error is the noise
-    assert _rmse_switched_on(meas, specimens, final) <= 1.3 * noise
+    assert _rmse_switched_on(meas, specimens, final, DENSE_STEPS) <= 1.3 * noise
 
 
 def test_effect_switched_on_for_calibration_comes_first(tmp_path, specimens, tables, signal):

@@ -24,7 +24,8 @@ Method (hand-written around scipy/statsmodels; see docs/validation.md):
   the predictions by a vector Δ; against the noise σ (stated, or else the final model's
   residual, an upper bound) it would be found when the ΔBIC it earns,
   -n ln(1 + |Δ|²/(n σ²)) + ln n, clears the pay threshold, and its parameter would come out
-  with relative standard deviation σ/|Δ| (linearised, other effects held).  A "no missing
+  with relative standard deviation σ/|Δ| in t (linearised, other effects held; for a value
+  tabulated as value^-p that is σ/(p|Δ|) of the value).  A "no missing
   effect found" therefore says which candidates this data could not have seen at all.
 """
 
@@ -181,7 +182,7 @@ class Fit:
         for k, (e, t) in enumerate(zip(self.effects, self.t)):
             sd_t = math.sqrt(max(self.cov_t[k, k], 0.0))
             p = get_effect(e).param(resp[e].param)
-            out[e] = sd_t / t ** 2 if p.transform == "reciprocal" and t != 0 else sd_t
+            out[e] = p.sd_from_t(t, sd_t)
         return out
 
 
@@ -255,8 +256,11 @@ def detectability(resp: dict[str, Response], noise: float, n: int, unit: str | N
     for name, r in resp.items():
         p = get_effect(name).param(r.param)
         realistic = p.realistic_for(unit)
-        delta = r.change(p.to_t(realistic))
+        t = p.to_t(realistic)
+        delta = r.change(t)
         size = float(np.linalg.norm(delta))
+        # relative sd of the value per relative sd of t (1, or 1/power for value**-power)
+        stretch = p.sd_from_t(t, t) / realistic if t != 0 else 1.0
         chi2 = (size / noise) ** 2 if noise > 0 else math.inf
         # the noise s that solves n ln(1 + size²/(n s²)) = need
         show = size / math.sqrt(n * math.expm1(need / n)) if size > 0 else 0.0
@@ -264,8 +268,8 @@ def detectability(resp: dict[str, Response], noise: float, n: int, unit: str | N
                      "change_rms_arcmin": size / math.sqrt(n), "change_max_arcmin": float(np.max(np.abs(delta))),
                      "expected_delta_bic": float(-n * math.log1p(chi2 / n) + math.log(n)) if math.isfinite(chi2)
                      else -math.inf,
-                     "expected_rel_sd": (1.0 / math.sqrt(chi2)) if chi2 > 0 else math.inf,
-                     "noise_to_show_arcmin": show, "noise_to_calibrate_arcmin": 0.075 * size,
+                     "expected_rel_sd": (stretch / math.sqrt(chi2)) if chi2 > 0 else math.inf,
+                     "noise_to_show_arcmin": show, "noise_to_calibrate_arcmin": 0.075 * size / stretch,
                      "visible": bool(size > 0 and noise < show)})
     return rows
 

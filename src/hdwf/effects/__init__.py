@@ -10,8 +10,8 @@ one file (``docs/adding-an-effect.md``).
 Calibration needs the model response over each parameter's range. Every parameter has a
 ``transform`` in which that response is close to linear and zero means "effect off":
 ``linear`` (the value itself, e.g. a friction coefficient) or ``reciprocal`` (1/value,
-e.g. a stiffness, whose compliance adds) — and a ``grid`` of values the per-specimen
-solves tabulate.
+e.g. a stiffness, whose compliance adds; with ``power`` p, value^-p: a ring on an elastic
+foundation deflects as k^-3/4) — and a ``grid`` of values the per-specimen solves tabulate.
 """
 
 from __future__ import annotations
@@ -36,18 +36,25 @@ class Parameter:
     transform: str = "linear"  # "linear" or "reciprocal": response ~ linear in it, 0 = off
     grid_points: int = 4       # tabulated values besides "off" (for FE-level effects)
     realistic_by_unit: tuple = ()   # ((unit, value), ...) where a drive's size changes it
+    power: float = 1.0         # "reciprocal" only: t = value**-power
 
     def realistic_for(self, unit: str | None) -> float:
         """The realistic value for one drive (``realistic`` unless the size changes it)."""
         return dict(self.realistic_by_unit).get(unit, self.realistic)
 
     def to_t(self, value: float) -> float:
-        return 1.0 / value if self.transform == "reciprocal" else float(value)
+        return float(value) ** -self.power if self.transform == "reciprocal" else float(value)
 
     def from_t(self, t: float) -> float:
         if self.transform == "reciprocal":
-            return math.inf if t == 0 else 1.0 / t
+            return math.inf if t == 0 else float(t) ** (-1.0 / self.power)
         return float(t)
+
+    def sd_from_t(self, t: float, sd_t: float) -> float:
+        """Standard uncertainty of the value from that of t (linearised: |dvalue/dt| sd_t)."""
+        if self.transform == "reciprocal" and t != 0:
+            return sd_t * self.from_t(t) / (self.power * abs(t))
+        return sd_t
 
     @property
     def t_bounds(self) -> tuple[float, float]:
@@ -60,7 +67,8 @@ class Parameter:
         lo, hi = self.t_bounds
         n = self.grid_points
         ts = [lo + (hi - lo) * k / n for k in range(n + 1)]
-        return [self.from_t(t) for t in ts if t != 0.0]
+        # clipped: the ends must be the bounds themselves, not their rounded round trip
+        return [min(max(self.from_t(t), self.lower), self.upper) for t in ts if t != 0.0]
 
     def check(self, value: float, where: str) -> float:
         v = float(value)
