@@ -493,7 +493,8 @@ def _detectability_part(doc: Document, diag: dict, level: int):
                  "about them (not finding them is no evidence that they are absent): " + "; ".join(
             f"{lit(get_effect(c['effect']).title)} (it changes the predictions by {fmt(c['change_rms_arcmin'], 2)} "
             f"arcmin RMS and needs noise below {fmt(c['noise_to_show_arcmin'], 2)} arcmin)" for c in hidden)
-            + (". Less noise (averaged repeat runs, a finer encoder) or more specimens would show them."
+            + (". Less noise (averaged repeat runs, a finer encoder), more readings per curve or more specimens "
+               "would show them: a parameter's sd falls with the square root of the number of independent readings."
                if diag.get("noise_arcmin") else
                ". No noise is stated, so the final model's residual stands in for it; that residual also holds "
                "whatever error the model cannot explain, and a large model error hides every candidate until it "
