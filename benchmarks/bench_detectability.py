@@ -22,7 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from hdwf.campaign import add_noise, plan_variants, solve_specimens, synth_curves, synth_designs
+from hdwf.campaign import (add_noise, mean_lost_motion, plan_variants, solve_specimens, synth_curves,
+                           synth_designs)
 from hdwf.diagnosis import diagnose
 from hdwf.effects import registry
 from hdwf.io import atomic_path
@@ -49,8 +50,7 @@ def main():
     specimens = synth_designs(UNIT, args.specimens, DESIGN_SEED)
     plan = plan_variants({})
     tables = solve_specimens(UNIT, specimens, SETTINGS, args.steps_per_ramp, lambda _: plan, jobs=args.jobs)
-    base = tables[tables["variant"] == "baseline"]
-    signal = float(base.groupby("specimen_id")["twist_arcmin"].agg(lambda t: t.max() - t.min()).mean())
+    signal = mean_lost_motion(tables)
     print(f"tables: {time.perf_counter() - t0:.0f} s; mean lost motion {signal:.3f} arcmin")
 
     rows = []

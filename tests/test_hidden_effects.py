@@ -31,8 +31,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from hdwf.campaign import (plan_variants, solve_specimens, synth_designs, synthesize,
-                           variant_key)
+from hdwf.campaign import (mean_lost_motion, plan_variants, solve_specimens, synth_designs,
+                           synthesize, variant_key)
 from hdwf.diagnosis import diagnose
 from hdwf.measurements import load_measurements
 
@@ -58,23 +58,26 @@ def specimens():
     return synth_designs(UNIT, N_SPECIMENS, SEED)
 
 
+def _campaign_tables(specimens, steps):
+    """The campaign model and every candidate's grid, solved for every specimen."""
+    plan = plan_variants({})
+    return solve_specimens(UNIT, specimens, SETTINGS, steps, lambda _: plan, jobs=JOBS)
+
+
 @pytest.fixture(scope="module")
 def tables(specimens):
-    plan = plan_variants({})
-    return solve_specimens(UNIT, specimens, SETTINGS, STEPS, lambda _: plan, jobs=JOBS)
+    return _campaign_tables(specimens, STEPS)
 
 
 @pytest.fixture(scope="module")
 def dense_tables(specimens):
-    plan = plan_variants({})
-    return solve_specimens(UNIT, specimens, SETTINGS, DENSE_STEPS, lambda _: plan, jobs=JOBS)
+    return _campaign_tables(specimens, DENSE_STEPS)
 
 
 @pytest.fixture(scope="module")
 def signal(tables):
     """Mean lost motion of the specimens (the twist range of each baseline curve)."""
-    base = tables[tables["variant"] == "baseline"]
-    return float(base.groupby("specimen_id")["twist_arcmin"].agg(lambda t: t.max() - t.min()).mean())
+    return mean_lost_motion(tables)
 
 
 def _measure(tmp_path, specimens, effects, noise, steps=STEPS):

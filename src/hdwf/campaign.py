@@ -145,6 +145,13 @@ def solve_specimens(unit: str, specimens: pd.DataFrame, settings: dict, steps_pe
 
 # ------------------------------------------------------------------ synthetic measurements
 
+def mean_lost_motion(table: pd.DataFrame, fixed: dict | None = None) -> float:
+    """Mean over specimens of the twist range of the campaign model's curves (arcmin): the
+    signal that noise levels are quoted against."""
+    base = table[table["variant"] == variant_key(fixed or {})]
+    return float(base.groupby("specimen_id")["twist_arcmin"].agg(lambda t: t.max() - t.min()).mean())
+
+
 def synth_designs(unit: str, n: int, seed: int) -> pd.DataFrame:
     """``n`` specimens by Latin hypercube (seeded) over the paper's Table 3 ranges."""
     from scipy.stats import qmc

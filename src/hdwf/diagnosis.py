@@ -39,7 +39,7 @@ import pandas as pd
 from scipy.interpolate import make_interp_spline
 from scipy.optimize import least_squares
 
-from .campaign import variant_key
+from .campaign import mean_lost_motion, variant_key
 from .effects import get as get_effect
 from .validation import Candidate, bic, comparison_points, residual_tests, summarise, verdict
 
@@ -304,9 +304,8 @@ def detectability_of_tables(table: pd.DataFrame, unit: str, noise_arcmin: float,
     obs["quantity"] = "twist"
     notes: dict[str, str] = {}
     resp = responses(table, obs, {}, candidates, notes)
-    lost_motion = base.groupby("specimen_id")["twist_arcmin"].agg(lambda t: t.max() - t.min())
     return {"unit": unit, "n_specimens": int(base["specimen_id"].nunique()), "n_points": int(len(obs)),
-            "noise_arcmin": float(noise_arcmin), "mean_lost_motion_arcmin": float(lost_motion.mean()),
+            "noise_arcmin": float(noise_arcmin), "mean_lost_motion_arcmin": mean_lost_motion(table),
             "pay_threshold": pay_threshold, "notes": notes,
             "candidates": detectability(resp, noise_arcmin, len(obs), unit, pay_threshold)}
 
