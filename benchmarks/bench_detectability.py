@@ -78,8 +78,8 @@ def main():
                         continue
                     # the estimate itself (noise stated in the data), not could_not_see, which
                     # leaves out effects that were found and so would agree by construction
-                    row = next(c for c in diag["detectability"]["candidates"] if c["effect"] == effect)
-                    predicted.append(row["visible"])
+                    seen = next(c for c in diag["detectability"]["candidates"] if c["effect"] == effect)
+                    predicted.append(seen["visible"])
                     if v["missing_effect"] == effect or effect in v["indistinguishable_from"]:
                         named += 1
                         est = next(r for r in diag["ranking"] if r["effect"] == effect)["params"][p.name]
@@ -90,8 +90,7 @@ def main():
                        "median_rel_error": statistics.median(errs) if errs else None,
                        "predicted_visible": (sum(predicted) / len(predicted)) if predicted else None,
                        "diagnose_s": statistics.median(secs)}
-                if effect:
-                    seen = next(c for c in diag["detectability"]["candidates"] if c["effect"] == effect)
+                if effect:      # the estimate depends on the stated noise only: the same for every seed
                     row.update(expected_rel_sd=seen["expected_rel_sd"], noise_to_show_arcmin=seen["noise_to_show_arcmin"],
                                change_rms_arcmin=seen["change_rms_arcmin"])
                 rows.append(row)
