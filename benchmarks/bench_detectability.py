@@ -10,7 +10,8 @@ could show the effect. The model tables (campaign model and every candidate's gr
 solved once and shared, as in a campaign.
 
 Usage: .venv/bin/python benchmarks/bench_detectability.py [--specimens 12] [--seeds 3]
-       [--noise-pct 2 0.5 0.2 0.1] [--steps-per-ramp 5] [--out detectability.json]
+       [--noise-pct 2 0.5 0.2 0.1] [--steps-per-ramp 5] [--range rFS_mm=0:0.002 ...]
+       [--out detectability.json]
 """
 
 import argparse
@@ -22,8 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from hdwf.campaign import (add_noise, mean_lost_motion, plan_variants, solve_specimens, synth_curves,
-                           synth_designs)
+from hdwf.campaign import (add_noise, mean_lost_motion, parse_range, plan_variants, solve_specimens,
+                           synth_curves, synth_designs)
 from hdwf.diagnosis import diagnose
 from hdwf.effects import registry
 from hdwf.io import atomic_path
@@ -42,12 +43,15 @@ def main():
                         help="noise levels in %% of the mean lost motion of the specimens")
     parser.add_argument("--steps-per-ramp", type=int, default=5,
                         help="points per curve = 4 x this + 1")
+    parser.add_argument("--range", action="append", default=[], metavar="NAME=LOW:HIGH",
+                        help="a batch instead of the paper's design space, e.g. rFS_mm=0:0.002 (repeatable)")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--out", type=Path, help="write the rows as JSON here")
     args = parser.parse_args()
 
+    ranges = {name: (lo, hi) for name, lo, hi in map(parse_range, args.range)}
     t0 = time.perf_counter()
-    specimens = synth_designs(UNIT, args.specimens, DESIGN_SEED)
+    specimens = synth_designs(UNIT, args.specimens, DESIGN_SEED, ranges)
     plan = plan_variants({})
     tables = solve_specimens(UNIT, specimens, SETTINGS, args.steps_per_ramp, lambda _: plan, jobs=args.jobs)
     signal = mean_lost_motion(tables)
@@ -61,7 +65,7 @@ def main():
                 p = registry()[effect].parameters[0]
                 hidden = {effect: {p.name: p.realistic}}
             clean = synth_curves(UNIT, args.specimens, DESIGN_SEED, hidden, SETTINGS, args.steps_per_ramp,
-                                 jobs=args.jobs)
+                                 jobs=args.jobs, ranges=ranges)
             for pct in args.noise_pct:
                 noise = pct / 100 * signal
                 named = recovered = 0
@@ -97,7 +101,8 @@ def main():
                 print(json.dumps(row))
 
     print(f"\nmean lost motion {signal:.3f} arcmin, {args.specimens} specimens of "
-          f"{4 * args.steps_per_ramp + 1} points, {args.seeds} seeds, "
+          f"{4 * args.steps_per_ramp + 1} points{''.join(f', {c} {lo:g}..{hi:g}' for c, (lo, hi) in ranges.items())}, "
+          f"{args.seeds} seeds, "
           f"total {time.perf_counter() - t0:.0f} s\n")
     print("| effect | noise (% / arcmin) | predicted visible | named | within 15 % | expected rel. sd |")
     print("|---|---|---|---|---|---|")
@@ -109,7 +114,7 @@ def main():
         print(f"| {r['effect']} | {r['noise_pct']:g} / {r['noise_arcmin']:.4f} | {vis} | {name} | {rec} | {sd} |")
     if args.out:
         with atomic_path(args.out) as tmp_out:
-            tmp_out.write_text(json.dumps({"signal_arcmin": signal, "steps_per_ramp": args.steps_per_ramp,
+            tmp_out.write_text(json.dumps({"signal_arcmin": signal, "steps_per_ramp": args.steps_per_ramp, "ranges": ranges,
                                            "rows": rows}, indent=1, default=float))
 
 

@@ -52,3 +52,19 @@ def test_samplers_are_uniform_and_seeded(sampler):
 def test_sobol_needs_power_of_two():
     with pytest.raises(ValueError, match="power of two"):
         unit_sample("sobol", 100, 3, seed=0)
+
+
+def test_synth_designs_sample_a_batch_inside_its_range():
+    """`--range` narrows the Latin hypercube of a synthetic campaign: one specimen in each of
+    the n equal strata of the narrowed range (the LHS property), the other parameters on the
+    paper's Table 3 ranges as before, the same seed giving the same specimens."""
+    from hdwf.campaign import synth_designs
+
+    n = 8
+    batch = synth_designs("hd42", n, 3, {"rFS_mm": (0.0, 0.002), "rCS_mm": (0.001, 0.001)})
+    strata = np.floor(batch["rFS_mm"].to_numpy() / 0.002 * n).astype(int)
+    assert sorted(strata) == list(range(n))
+    assert (batch["rCS_mm"] == 0.001).all()                       # a zero-width range fixes it
+    full = synth_designs("hd42", n, 3)
+    np.testing.assert_array_equal(batch["d_mm"], full["d_mm"])    # same hypercube, other columns unchanged
+    np.testing.assert_allclose(full["rFS_mm"] / 0.02, batch["rFS_mm"] / 0.002, rtol=1e-12)

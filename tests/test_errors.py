@@ -102,3 +102,22 @@ def test_plan_command_refuses_bad_input_before_solving(tmp_path, capsys):
     rc = main(["plan", "--unit", "hd42", "--designs", "3", "--seed", "1", "--noise-arcmin", "0"])
     err = capsys.readouterr().err
     assert rc == 2 and "noise_arcmin" in err and "0" in err
+
+
+@pytest.mark.parametrize("text, says", [
+    ("rFS_mm=0:0.05", "leaves what the hd42 model supports (0:0.04)"),   # Table 3 span either side
+    ("rFS_mm=0.002:0.001", "low <= high"),
+    ("x_mm=0:1", "unknown parameter 'x_mm'"),
+    ("rFS_mm0:0.002", "expected NAME=LOW:HIGH"),
+])
+def test_synth_refuses_a_bad_design_range_before_solving(tmp_path, capsys, text, says):
+    """`hdwf synth --range`: a range outside the model's support, reversed, of an unknown
+    parameter or badly written is named with the option and its value; no file is written."""
+    from hdwf.cli import main
+
+    out = tmp_path / "m.csv"
+    rc = main(["synth", "--unit", "hd42", "--designs", "2", "--seed", "1", "--noise-arcmin", "0.01",
+               "--range", text, "--out", str(out)])
+    err = capsys.readouterr().err
+    assert rc == 2 and f"field '--range', value '{text}'" in err and says in err, err
+    assert not out.exists()

@@ -152,40 +152,78 @@ def mean_lost_motion(table: pd.DataFrame, fixed: dict | None = None) -> float:
     return float(base.groupby("specimen_id")["twist_arcmin"].agg(lambda t: t.max() - t.min()).mean())
 
 
-def synth_designs(unit: str, n: int, seed: int) -> pd.DataFrame:
-    """``n`` specimens by Latin hypercube (seeded) over the paper's Table 3 ranges."""
+def synth_designs(unit: str, n: int, seed: int,
+                  ranges: dict[str, tuple[float, float]] | None = None) -> pd.DataFrame:
+    """``n`` specimens by Latin hypercube (seeded) over the paper's Table 3 ranges, or over
+    ``ranges`` ({column: (low, high)}, e.g. ``{"rFS_mm": (0, 0.002)}``) where given: a batch
+    like the one on the bench rather than the paper's design space (docs/validation.md)."""
     from scipy.stats import qmc
 
     from . import PARAMETERS
-    from .measurements import _TABLE3
 
-    bounds = _TABLE3[unit]
-    lo = np.array([bounds[p][0] for p in PARAMETERS])
-    hi = np.array([bounds[p][1] for p in PARAMETERS])
+    bounds = design_ranges(unit, ranges)
+    lo = np.array([bounds[c][0] for c in PARAMETER_COLUMNS])
+    hi = np.array([bounds[c][1] for c in PARAMETER_COLUMNS])
     u = qmc.LatinHypercube(d=len(PARAMETERS), seed=seed).random(n)
-    x = qmc.scale(u, lo, hi)
+    x = lo + u * (hi - lo)      # qmc.scale refuses a zero-width range; a fixed value is allowed
     df = pd.DataFrame(x, columns=list(PARAMETER_COLUMNS))
     df.insert(0, "unit", unit)
     df.insert(0, "specimen_id", [f"{unit}-s{i + 1:03d}" for i in range(n)])
     return df
 
 
+def design_ranges(unit: str, ranges: dict[str, tuple[float, float]] | None = None) -> dict[str, tuple[float, float]]:
+    """The sampling range of every parameter column: Table 3's, replaced by ``ranges`` where
+    given. A range must lie inside what the model supports (``measurements.supported_bounds``)."""
+    from .measurements import _TABLE3, supported_bounds
+
+    if unit not in _TABLE3:
+        raise ValueError(f"unknown drive {unit!r}; known: {', '.join(_TABLE3)}")
+    out = {f"{p}_mm": (float(lo), float(hi)) for p, (lo, hi) in _TABLE3[unit].items()}
+    supported = {f"{p}_mm": b for p, b in supported_bounds(unit).items()}
+    for col, (lo, hi) in (ranges or {}).items():
+        if col not in out:
+            raise ValueError(f"unknown parameter {col!r} in a design range; known: {', '.join(out)}")
+        if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
+            raise ValueError(f"design range of {col} must be low <= high, got {lo!r}:{hi!r}")
+        s_lo, s_hi = supported[col]
+        if lo < s_lo or hi > s_hi:
+            raise ValueError(f"design range {col} = {lo:g}:{hi:g} leaves what the {unit} model supports "
+                             f"({s_lo:g}:{s_hi:g})")
+        out[col] = (float(lo), float(hi))
+    return out
+
+
+def parse_range(text: str) -> tuple[str, float, float]:
+    """``"rFS_mm=0:0.002"`` -> ``("rFS_mm", 0.0, 0.002)`` (the ``--range`` option)."""
+    name, sep, rest = text.partition("=")
+    low, sep2, high = rest.partition(":")
+    try:
+        if not (sep and sep2 and name.strip()):
+            raise ValueError
+        return name.strip(), float(low), float(high)
+    except ValueError:
+        raise ValueError(f"expected NAME=LOW:HIGH (e.g. rFS_mm=0:0.002), got {text!r}") from None
+
+
 def synthesize(unit: str, n_designs: int, seed: int, noise_arcmin: float,
                effects: dict[str, dict[str, float]] | None, settings: dict,
-               steps_per_ramp: int = 5, jobs: int = 1) -> pd.DataFrame:
+               steps_per_ramp: int = 5, jobs: int = 1,
+               ranges: dict[str, tuple[float, float]] | None = None) -> pd.DataFrame:
     """Measurements in the documented curve form from the FE model with ``effects`` on:
     the solved curve of each specimen plus Gaussian noise of ``noise_arcmin`` (seeded),
     with ``u_twist_arcmin`` = the noise level. A failed solve raises (no silent rows)."""
     if noise_arcmin < 0 or not math.isfinite(noise_arcmin):
         raise ValueError(f"noise_arcmin must be >= 0, got {noise_arcmin!r}")
-    return add_noise(synth_curves(unit, n_designs, seed, effects, settings, steps_per_ramp, jobs),
+    return add_noise(synth_curves(unit, n_designs, seed, effects, settings, steps_per_ramp, jobs, ranges),
                      noise_arcmin, seed)
 
 
 def synth_curves(unit: str, n_designs: int, seed: int, effects: dict[str, dict[str, float]] | None,
-                 settings: dict, steps_per_ramp: int = 5, jobs: int = 1) -> pd.DataFrame:
+                 settings: dict, steps_per_ramp: int = 5, jobs: int = 1,
+                 ranges: dict[str, tuple[float, float]] | None = None) -> pd.DataFrame:
     """The noise-free curves ``synthesize`` starts from (one solve per specimen)."""
-    specimens = synth_designs(unit, n_designs, seed)
+    specimens = synth_designs(unit, n_designs, seed, ranges)
     effects = effects or {}
     model_changes(effects)    # checks names, parameters and bounds before any solve
     table = solve_specimens(unit, specimens, settings, steps_per_ramp, lambda _: [effects], jobs)

@@ -45,6 +45,24 @@ def _specimen_options(p, seed_help: str, noise_help: str) -> None:
     p.add_argument("--designs", type=int, required=True, help="number of specimens")
     p.add_argument("--seed", type=int, required=True, help=seed_help)
     p.add_argument("--noise-arcmin", type=float, required=True, help=noise_help)
+    p.add_argument("--range", action="append", default=[], metavar="NAME=LOW:HIGH",
+                   help="sample this parameter over LOW..HIGH instead of the paper's Table 3 range, e.g. "
+                        "rFS_mm=0:0.002 for a batch of accuracy-grade drives (repeatable)")
+
+
+def _design_ranges(args) -> dict[str, tuple[float, float]]:
+    """The --range options as {column: (low, high)}, checked against the model's support."""
+    from .campaign import design_ranges, parse_range
+
+    ranges = {}
+    for text in args.range:
+        try:
+            name, low, high = parse_range(text)
+            design_ranges(args.unit, {name: (low, high)})
+        except ValueError as exc:
+            raise InputError("command line", str(exc), field="--range", value=text) from None
+        ranges[name] = (low, high)
+    return ranges
 
 
 def _solve_options(p, elements_over_height: int, elements_over_thickness: int) -> None:
@@ -64,6 +82,7 @@ def _synth(args) -> int:
     if out.suffix.lower() not in (".csv", ".parquet"):
         raise InputError(out, f"unknown file type '{out.suffix}': write .csv or .parquet", field="--out")
     _refuse_existing(out, args, "measurement files are never overwritten: ")
+    ranges = _design_ranges(args)
     effects: dict[str, dict[str, float]] = {}
     for text in args.effect:
         try:
@@ -73,7 +92,7 @@ def _synth(args) -> int:
         effects.setdefault(name, {})[pname] = value
     try:
         data = synthesize(args.unit, args.designs, args.seed, args.noise_arcmin, effects, _mesh_settings(args),
-                          steps_per_ramp=args.steps_per_ramp, jobs=args.jobs)
+                          steps_per_ramp=args.steps_per_ramp, jobs=args.jobs, ranges=ranges)
     except ValueError as exc:
         raise InputError("command line", str(exc)) from None
     with atomic_path(out) as tmp:
@@ -82,7 +101,8 @@ def _synth(args) -> int:
         else:
             data.to_parquet(tmp, index=False)
     hidden = ", ".join(f"{n}:{p}={v:g}" for n, ps in effects.items() for p, v in ps.items()) or "none"
-    print(f"{out}: {args.designs} specimens of {args.unit}, {len(data)} points; effects: {hidden}; "
+    batch = "".join(f", {c} {lo:g}..{hi:g}" for c, (lo, hi) in ranges.items())
+    print(f"{out}: {args.designs} specimens of {args.unit}{batch}, {len(data)} points; effects: {hidden}; "
           f"noise {args.noise_arcmin:g} arcmin (seed {args.seed})")
     return 0
 
@@ -107,13 +127,15 @@ def _plan(args) -> int:
     out = Path(args.out) if args.out else None
     if out is not None:
         _refuse_existing(out, args)
+    ranges = _design_ranges(args)
     try:
-        specimens = synth_designs(args.unit, args.designs, args.seed)
+        specimens = synth_designs(args.unit, args.designs, args.seed, ranges)
         plan = plan_detectability(args.unit, specimens, _mesh_settings(args), args.steps_per_ramp,
                                   args.noise_arcmin, jobs=args.jobs)
     except ValueError as exc:
         raise InputError("command line", str(exc)) from None
-    print(f"{plan['n_specimens']} specimens of {args.unit} (mean lost motion {plan['mean_lost_motion_arcmin']:.3f} "
+    batch = "".join(f", {c} {lo:g}..{hi:g}" for c, (lo, hi) in ranges.items())
+    print(f"{plan['n_specimens']} specimens of {args.unit}{batch} (mean lost motion {plan['mean_lost_motion_arcmin']:.3f} "
           f"arcmin), {plan['n_points']} points, noise {args.noise_arcmin:g} arcmin per point:")
     print(f"  {'effect':<16} {'realistic':>12} {'change RMS':>11} {'noise to show':>14} {'to calibrate':>13} "
           f"{'sd':>7}  visible")
