@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hdwf.campaign import (add_noise, mean_lost_motion, parse_range, plan_variants, solve_specimens,
+from hdwf.campaign import (add_noise, design_ranges, mean_lost_motion, parse_range, plan_variants, solve_specimens,
                            synth_curves, synth_designs)
 from hdwf.diagnosis import diagnose
 from hdwf.effects import registry
@@ -49,7 +49,11 @@ def main():
     parser.add_argument("--out", type=Path, help="write the rows as JSON here")
     args = parser.parse_args()
 
-    ranges = {name: (lo, hi) for name, lo, hi in map(parse_range, args.range)}
+    try:
+        ranges = {name: (lo, hi) for name, lo, hi in map(parse_range, args.range)}
+        design_ranges(UNIT, ranges)
+    except ValueError as exc:
+        parser.error(f"--range: {exc}")
     t0 = time.perf_counter()
     specimens = synth_designs(UNIT, args.specimens, DESIGN_SEED, ranges)
     plan = plan_variants({})

@@ -109,6 +109,7 @@ def test_plan_command_refuses_bad_input_before_solving(tmp_path, capsys):
     ("rFS_mm=0.002:0.001", "low <= high"),
     ("x_mm=0:1", "unknown parameter 'x_mm'"),
     ("rFS_mm0:0.002", "expected NAME=LOW:HIGH"),
+    ("rFS_mm=nan:0.002", "two finite numbers"),
 ])
 def test_synth_refuses_a_bad_design_range_before_solving(tmp_path, capsys, text, says):
     """`hdwf synth --range`: a range outside the model's support, reversed, of an unknown
@@ -121,3 +122,13 @@ def test_synth_refuses_a_bad_design_range_before_solving(tmp_path, capsys, text,
     err = capsys.readouterr().err
     assert rc == 2 and f"field '--range', value '{text}'" in err and says in err, err
     assert not out.exists()
+
+
+def test_plan_refuses_a_design_range_given_twice(capsys):
+    """The same parameter twice in `hdwf plan --range` would silently keep the last one."""
+    from hdwf.cli import main
+
+    rc = main(["plan", "--unit", "hd42", "--designs", "2", "--seed", "1", "--noise-arcmin", "0.05",
+               "--range", "rFS_mm=0:0.002", "--range", "rFS_mm=0:0.001"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "field '--range', value 'rFS_mm=0:0.001'" in err and "twice" in err, err

@@ -184,7 +184,9 @@ def design_ranges(unit: str, ranges: dict[str, tuple[float, float]] | None = Non
     for col, (lo, hi) in (ranges or {}).items():
         if col not in out:
             raise ValueError(f"unknown parameter {col!r} in a design range; known: {', '.join(out)}")
-        if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
+        if not (math.isfinite(lo) and math.isfinite(hi)):
+            raise ValueError(f"design range of {col} must be two finite numbers, got {lo!r}:{hi!r}")
+        if lo > hi:
             raise ValueError(f"design range of {col} must be low <= high, got {lo!r}:{hi!r}")
         s_lo, s_hi = supported[col]
         if lo < s_lo or hi > s_hi:

@@ -58,6 +58,8 @@ def _design_ranges(args) -> dict[str, tuple[float, float]]:
     for text in args.range:
         try:
             name, low, high = parse_range(text)
+            if name in ranges:
+                raise ValueError(f"{name} is given a range twice")
             design_ranges(args.unit, {name: (low, high)})
         except ValueError as exc:
             raise InputError("command line", str(exc), field="--range", value=text) from None
