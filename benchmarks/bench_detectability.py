@@ -23,8 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from hdwf.campaign import (add_noise, design_ranges, mean_lost_motion, parse_range, plan_variants, solve_specimens,
-                           synth_curves, synth_designs)
+from hdwf.campaign import (add_noise, design_ranges, format_ranges, mean_lost_motion, parse_range,
+                           plan_variants, solve_specimens, synth_curves, synth_designs)
 from hdwf.diagnosis import diagnose
 from hdwf.effects import registry
 from hdwf.io import atomic_path
@@ -105,7 +105,7 @@ def main():
                 print(json.dumps(row))
 
     print(f"\nmean lost motion {signal:.3f} arcmin, {args.specimens} specimens of "
-          f"{4 * args.steps_per_ramp + 1} points{''.join(f', {c} {lo:g}..{hi:g}' for c, (lo, hi) in ranges.items())}, "
+          f"{4 * args.steps_per_ramp + 1} points{format_ranges(ranges)}, "
           f"{args.seeds} seeds, "
           f"total {time.perf_counter() - t0:.0f} s\n")
     print("| effect | noise (% / arcmin) | predicted visible | named | within 15 % | expected rel. sd |")

@@ -208,6 +208,11 @@ def parse_range(text: str) -> tuple[str, float, float]:
         raise ValueError(f"expected NAME=LOW:HIGH (e.g. rFS_mm=0:0.002), got {text!r}") from None
 
 
+def format_ranges(ranges: dict[str, tuple[float, float]]) -> str:
+    """``", rFS_mm 0..0.002, ..."``: the design ranges for a printed summary ("" for none)."""
+    return "".join(f", {c} {lo:g}..{hi:g}" for c, (lo, hi) in ranges.items())
+
+
 def synthesize(unit: str, n_designs: int, seed: int, noise_arcmin: float,
                effects: dict[str, dict[str, float]] | None, settings: dict,
                steps_per_ramp: int = 5, jobs: int = 1,

@@ -76,7 +76,7 @@ def _solve_options(p, elements_over_height: int, elements_over_thickness: int) -
 
 
 def _synth(args) -> int:
-    from .campaign import synthesize
+    from .campaign import format_ranges, synthesize
     from .effects import parse_assignment
     from .io import atomic_path
 
@@ -103,7 +103,7 @@ def _synth(args) -> int:
         else:
             data.to_parquet(tmp, index=False)
     hidden = ", ".join(f"{n}:{p}={v:g}" for n, ps in effects.items() for p, v in ps.items()) or "none"
-    batch = "".join(f", {c} {lo:g}..{hi:g}" for c, (lo, hi) in ranges.items())
+    batch = format_ranges(ranges)
     print(f"{out}: {args.designs} specimens of {args.unit}{batch}, {len(data)} points; effects: {hidden}; "
           f"noise {args.noise_arcmin:g} arcmin (seed {args.seed})")
     return 0
@@ -122,7 +122,7 @@ def _effects(args) -> int:
 
 
 def _plan(args) -> int:
-    from .campaign import synth_designs
+    from .campaign import format_ranges, synth_designs
     from .diagnosis import json_safe, plan_detectability
     from .io import atomic_path
 
@@ -136,7 +136,7 @@ def _plan(args) -> int:
                                   args.noise_arcmin, jobs=args.jobs)
     except ValueError as exc:
         raise InputError("command line", str(exc)) from None
-    batch = "".join(f", {c} {lo:g}..{hi:g}" for c, (lo, hi) in ranges.items())
+    batch = format_ranges(ranges)
     print(f"{plan['n_specimens']} specimens of {args.unit}{batch} (mean lost motion {plan['mean_lost_motion_arcmin']:.3f} "
           f"arcmin), {plan['n_points']} points, noise {args.noise_arcmin:g} arcmin per point:")
     print(f"  {'effect':<16} {'realistic':>12} {'change RMS':>11} {'noise to show':>14} {'to calibrate':>13} "
