@@ -17,12 +17,13 @@ over all points (diagnosis.detectability).
 
 * The paper's design space, curves of 21 points (5 steps per ramp): the dead-band effects
   (thermal, Oldham play) are found at 2 % noise; at 2 % the elastic ones are rightly not
-  claimed; no hidden effect gives no verdict; two hidden effects (temperature, cup) are found
-  in two rounds at 1 %.
+  claimed; no hidden effect gives no verdict.
 * An accuracy-grade batch (tooth offsets within 2 µm of the zero-backlash design, lost
   motion about 2.8 arcmin: the model's nearest to a catalogue unit's 1 arcmin), curves of
   401 points (100 steps per ramp, a bench logging continuously), 2 % noise = 0.056 arcmin:
-  cup torsion and housing compliance are found and recovered within 15 %.
+  cup torsion and housing compliance are found and recovered within 15 %; two hidden
+  effects (temperature, cup) are found in two rounds, with the first recalibrated on actual
+  solves before the second round (``diagnose(..., solve=...)``, as the workflow does).
 * Flank friction changes the curves by 0.0034 arcmin RMS: on the batch at 2 % it is named
   in this seed (0 of 3 benchmark seeds) but mu comes out with an expected sd of 24 %, so its
   test is marked xfail with the measured reason rather than weakened; at 0.2 % on the
@@ -180,27 +181,36 @@ def test_elastic_effects_are_not_claimed_below_the_noise(tmp_path, specimens, ta
     assert not {"thermal", "oldham_play"} & set(diag["verdict"]["could_not_see"])
 
 
-def test_two_hidden_effects_found_in_two_rounds(tmp_path, specimens, tables, signal):
-    """A temperature difference and cup torsion, noise of 1 % of the signal on 21-point
-    curves of the paper's design space. (On the dense accuracy batch at 2 % the second round
-    names housing compliance instead of cup torsion, docs/validation.md: near zero clearance
-    the thermal response bends between its 10 K grid values, and that interpolation error,
-    a tenth of the noise, tips the two look-alikes.)"""
+def test_two_hidden_effects_found_in_two_rounds(tmp_path, batch_specimens, dense_tables, batch_signal):
+    """A temperature difference (12 K) and cup torsion, noise of 2 % of the signal on the
+    dense accuracy batch. Round 1 finds the temperature; before round 2 it is recalibrated on
+    actual solves near its estimate, because the table's spline is off by 0.006 arcmin RMS at
+    12 K (teeth close between the 10 K grid values), which with 4812 readings made housing
+    compliance beat cup torsion by ΔBIC 10.9 (docs/validation.md). Round 2 then names cup
+    torsion or its look-alike, housing compliance: on these curves the two fit equally well
+    (actual solves at their best values: RSS within 0.002 %), and the verdict must say so
+    rather than pick one."""
     hidden = {"thermal": {"delta_T_K": 12.0}, "fs_cup_torsion": {"K_Nm_per_rad": 6.0e4}}
-    noise = 0.01 * signal
-    meas = _measure(tmp_path, specimens, hidden, noise)
-    diag, _ = diagnose(meas, tables)
+    noise = 0.02 * batch_signal
+    meas = _measure(tmp_path, batch_specimens, hidden, noise, DENSE_STEPS, BATCH)
+
+    def solve(variants):
+        return solve_specimens(UNIT, batch_specimens, SETTINGS, DENSE_STEPS, lambda _: variants, jobs=JOBS)
+
+    diag, _ = diagnose(meas, dense_tables, solve=solve)
     found = diag["verdict"]["found_in_order"]
-    rounds = diag["rounds"]
     assert len(found) == 2 and found[0] == "thermal", found
-    # the second round's winner is cup torsion or its look-alike, housing compliance
-    second = rounds[1]["verdict"]
-    assert "fs_cup_torsion" in [second["missing_effect"], *second["indistinguishable_from"]], second
-    final = diag["final"]["effects"]
-    assert final["thermal"]["delta_T_K"] == pytest.approx(12.0, rel=0.15)
-    assert final["fs_cup_torsion"]["K_Nm_per_rad"] == pytest.approx(6.0e4, rel=0.15)
+    assert "actual solves at delta_T_K" in diag["refinement"]["thermal"]
+    second = diag["rounds"][1]
+    assert "fs_cup_torsion" in [second["verdict"]["missing_effect"], *second["verdict"]["indistinguishable_from"]], \
+        second["verdict"]
+    K = next(r for r in second["ranking"] if r["effect"] == "fs_cup_torsion")["params"]["K_Nm_per_rad"]
+    assert K == pytest.approx(6.0e4, rel=0.15)
+    dT = diag["final"]["effects"]["thermal"]["delta_T_K"]
+    assert dT == pytest.approx(12.0, rel=0.15)
     # both switched on at their calibrated values, actual solves: the error is the noise
-    assert _rmse_switched_on(meas, specimens, final) <= 1.3 * noise
+    both = {"thermal": {"delta_T_K": dT}, "fs_cup_torsion": {"K_Nm_per_rad": K}}
+    assert _rmse_switched_on(meas, batch_specimens, both, DENSE_STEPS) <= 1.3 * noise
 
 
 def test_effect_switched_on_for_calibration_comes_first(tmp_path, specimens, tables, signal):

@@ -128,3 +128,59 @@ def test_report_says_which_effects_the_data_could_not_show():
     doc0 = Document("t", "s", {})
     _detectability_part(doc0, diag0, 2)
     assert doc0.blocks[-1]["type"] == "table" and doc0.blocks[-1]["rows"][0][-1] == "yes"
+
+
+def _kinked_thermal(n_points=60, seed=5):
+    """A thermal response with kinks between the table's grid values (teeth closing one by
+    one): twist_i(dT) = base_i - g_i max(dT - k_i, 0), g_i > 0 (the dead band shrinks), kinks
+    k_i in 11..14 or 20..23 K (straight in between); and a ``solve`` that returns it exactly for
+    any variant, counting its calls."""
+    from hdwf.campaign import plan_variants, variant_key
+
+    rng = np.random.default_rng(seed)
+    g = rng.uniform(0.01, 0.03, n_points)
+    k = np.where(np.arange(n_points) % 2 == 0, rng.uniform(11, 14, n_points), rng.uniform(20, 23, n_points))
+    base = rng.normal(1.0, 0.3, n_points)
+    steps = np.arange(n_points)
+    calls = []
+
+    def twist(variant):
+        dT = variant.get("thermal", {}).get("delta_T_K", 0.0)
+        return base - g * np.maximum(dT - k, 0.0)
+
+    def solve(variants):
+        calls.append(len(variants))
+        return pd.concat([pd.DataFrame({"specimen_id": "s1", "variant": variant_key(v), "step": steps,
+                                        "torque_Nm": np.sin(steps), "twist_arcmin": twist(v), "status": "ok"})
+                          for v in variants], ignore_index=True)
+
+    table = solve(plan_variants({}, ["thermal"]))
+    calls.clear()
+    obs = pd.DataFrame({"specimen_id": "s1", "step": steps, "torque_Nm": np.sin(steps), "quantity": "twist"})
+    return table, obs, twist, solve, calls
+
+
+def test_anchoring_on_actual_solves_removes_the_tables_interpolation_error():
+    """Between the thermal grid's values (every 10 K) kinks make the table's spline wrong: a
+    calibration on it misses dT = 17 K of noise-free data. Anchored on exact solves around its
+    estimate (three per move), the response is exact there (straight between the kinks, so
+    the quadratic through the three is exact) and the calibration recovers 17 K; the log names
+    where it solved."""
+    from hdwf.diagnosis import Fit, calibrate, refine_fit, responses
+
+    table, obs, twist, solve, calls = _kinked_thermal()
+    resp = responses(table, obs, {}, ["thermal"])
+    S0 = twist({})
+    D = twist({"thermal": {"delta_T_K": 17.0}})
+    plain = calibrate(D, S0, resp, ["thermal"])
+    assert abs(plain.t[0] - 17.0) > 0.1           # the spline's error shows in the estimate (0.19 K)
+    log = {}
+    table_resp = dict(resp)
+    fit = refine_fit(D, S0, resp, table_resp, plain, solve, obs, {}, log)
+    assert isinstance(fit, Fit) and fit.t[0] == pytest.approx(17.0, abs=1e-6)
+    assert fit.rss == pytest.approx(0.0, abs=1e-16)
+    assert calls and all(c == 3 for c in calls)
+    lo, hi = resp["thermal"].anchor[0][[0, -1]]
+    assert lo <= 17.0 <= hi and hi - lo == pytest.approx(2.0)     # ± a tenth of the 10 K spacing
+    assert "actual solves at delta_T_K" in log["thermal"]
+    assert table_resp["thermal"].anchor is None                   # the table's response is kept

@@ -102,7 +102,7 @@ def test_validation_campaign_chain(tmp_path):
     demo[demo["specimen_id"].isin(keep)].to_csv(ws / "data/validation/tiny.csv", index=False)
     config = yaml.safe_load((ws / "config.yaml").read_text())
     config["validation"] = {"tiny": {"unit": "hd42", "measurements": "data/validation/tiny.csv",
-                                     "candidates": ["thermal", "oldham_play"], "rounds": 1,
+                                     "candidates": ["thermal", "oldham_play"], "rounds": 2,
                                      "mesh": {"elements_over_height": 5, "elements_over_thickness": 3}}}
     (ws / "config.yaml").write_text(yaml.safe_dump(config))
     target = "results/validation/tiny/ladder.parquet"
@@ -114,6 +114,9 @@ def test_validation_campaign_chain(tmp_path):
     assert diag["verdict"]["missing_effect"] == "thermal"      # the demo data hide 12 K
     assert diag["ranking"][0]["effect"] == "thermal" and diag["baseline"]["rmse_arcmin"] > 0.1
     assert set(diag["ranking"][0]) >= {"effect", "params", "rmse_arcmin", "delta_bic"}
+    # before round 2 the diagnosis job re-solved thermal around its estimate (2 processes)
+    assert "actual solves at delta_T_K" in diag["refinement"]["thermal"], diag["refinement"]
+    assert len(diag["rounds"]) == 2
     ladder = pd.read_parquet(ws / target)
     assert list(ladder["model"]) == ["baseline", "with thermal"]
     assert ladder["rmse_arcmin"].iloc[1] < 0.5 * ladder["rmse_arcmin"].iloc[0]

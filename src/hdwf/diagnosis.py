@@ -107,15 +107,30 @@ class Response:
     t: np.ndarray          # sorted grid in the transformed parameter (includes 0 = off)
     S: np.ndarray          # (len(t), n_obs)
     t_bounds: tuple[float, float]
+    off: np.ndarray | None = None   # the prediction with the effect off (default: the row at t = 0)
+    # actual solves near an estimate: (their three t, their predictions), see anchored_response
+    anchor: tuple[np.ndarray, np.ndarray] | None = None
 
     def __post_init__(self):
         k = min(3, len(self.t) - 1)
         self._spline = make_interp_spline(self.t, self.S, k=k, axis=0)
-        self._off = self.S[int(np.argmin(np.abs(self.t)))]   # the tabulated "off" row (t = 0)
+        if self.off is None:
+            self.off = self.S[int(np.argmin(np.abs(self.t)))]
+        if self.anchor is not None:
+            ta, Sa = self.anchor
+            self._local = make_interp_spline(ta, Sa, k=2, axis=0)
+            self._shift = (Sa[0] - self._spline(ta[0]), Sa[-1] - self._spline(ta[-1]))
 
     def change(self, t: float) -> np.ndarray:
         """Prediction at t minus the prediction with the effect off."""
-        return self._spline(float(t)) - self._off
+        t = float(t)
+        if self.anchor is None:
+            return self._spline(t) - self.off
+        ta = self.anchor[0]
+        if ta[0] <= t <= ta[-1]:        # the quadratic through the actual solves
+            return self._local(t) - self.off
+        # outside: the spline, shifted to meet them (continuous at both ends)
+        return self._spline(t) + self._shift[0 if t < ta[0] else 1] - self.off
 
     def value(self, t: float) -> float:
         return get_effect(self.effect).param(self.param).from_t(t)
@@ -229,6 +244,76 @@ def calibrate(D: np.ndarray, S0: np.ndarray, resp: dict[str, Response], effects:
     return Fit(list(effects), t, cov, S, float(r @ r), n)
 
 
+# Refinement by actual solves: around an estimate t the response is solved at t - h, t, t + h,
+# h this share of the table's grid spacing; the estimate may leave that interval this often.
+ANCHOR_HALF_WIDTH = 0.1
+ANCHOR_MOVES = 4
+
+
+def anchored_response(table_resp: Response, t_hat: float, solve, obs: pd.DataFrame,
+                      fixed: dict) -> Response | None:
+    """The table's response of one effect anchored to actual solves at t_hat - h, t_hat and
+    t_hat + h (h = ``ANCHOR_HALF_WIDTH`` of the grid spacing): between them the quadratic
+    through the three solves, outside the table's spline shifted to meet it.
+
+    Why: a spline through the table's grid is off by up to a few hundredths of an arcmin where
+    tooth pairs close between two grid values (thermal near zero clearance,
+    docs/validation.md); with thousands of readings that is enough to tip two look-alike
+    candidates in the next round, whose joint fits move this estimate by up to about h.
+    ``solve(variants)`` returns the table rows of every specimen for those variants. Returns
+    None when a solve failed (the table's response is then kept)."""
+    p = get_effect(table_resp.effect).param(table_resp.param)
+    lo, hi = table_resp.t_bounds
+    h = ANCHOR_HALF_WIDTH * float(np.min(np.diff(table_resp.t)))
+    centre = min(max(float(t_hat), lo + h), hi - h)
+    values = [min(max(p.from_t(t), p.lower), p.upper) for t in (centre - h, centre, centre + h)]
+    variants = [{**fixed, table_resp.effect: {p.name: v}} for v in values]
+    tab = solve(variants)
+    ts = np.array([p.to_t(v) for v in values])
+    S = np.array([predict(tab, obs, variant_key(v)) for v in variants])
+    if not np.isfinite(S).all():
+        return None
+    return Response(table_resp.effect, table_resp.param, table_resp.t, table_resp.S, table_resp.t_bounds,
+                    off=table_resp.off, anchor=(ts, S))
+
+
+def refine_fit(D, S0, resp: dict, table_resp: dict, fit: Fit, solve, obs, fixed: dict,
+               log: dict) -> Fit:
+    """Anchor the response of every switched-on effect that needs a contact solve to actual
+    solves around its calibrated value (``anchored_response``) and recalibrate, until every
+    estimate sits inside its solved interval (or on the parameter's bound). Series effects
+    are exact in the table (their twist adds to the solved one) and are not anchored.
+    ``log`` gets one sentence per effect: where it was solved, or why the table was kept."""
+    on, failed = fit.effects, set()
+    for move in range(ANCHOR_MOVES + 1):
+        stale = []
+        for k, e in enumerate(on):
+            if get_effect(e).series or e in failed:
+                continue
+            a, t = resp[e].anchor, fit.t[k]
+            lo, hi = table_resp[e].t_bounds
+            if a is None or not (a[0][0] <= t <= a[0][-1] or t <= lo or t >= hi):
+                stale.append(e)
+        if not stale:
+            return fit
+        if move == ANCHOR_MOVES:
+            log["unsettled"] = (f"the estimate of {', '.join(stale)} still left its solved interval after "
+                                f"{ANCHOR_MOVES} moves; the last anchored response is used")
+            return fit
+        for e in stale:
+            r = anchored_response(table_resp[e], fit.t[on.index(e)], solve, obs, fixed)
+            if r is None:
+                log[e] = "a solve near its estimate failed; the table's response is used"
+                resp[e] = table_resp[e]
+                failed.add(e)
+                continue
+            resp[e] = r
+            log[e] = (f"calibrated on the table corrected by actual solves at {table_resp[e].param} = "
+                      + ", ".join(f"{r.value(t):.6g}" for t in r.anchor[0]))
+        fit = calibrate(D, S0, resp, on, start=list(fit.t))
+    return fit
+
+
 def loo_rmse(D, S0, resp, effects, fit: Fit, specimen: np.ndarray) -> float:
     """Leave one specimen out: calibrate on the others, predict the one left out."""
     if not effects:
@@ -319,10 +404,17 @@ def _cosine(a: np.ndarray, b: np.ndarray) -> float:
 
 def diagnose(meas, table: pd.DataFrame, fixed: dict | None = None, calibrate_first: list[str] | None = None,
              candidates: list[str] | None = None, max_rounds: int = 2, pay_threshold: float = 10.0,
-             tie_threshold: float = 6.0) -> tuple[dict, pd.DataFrame]:
+             tie_threshold: float = 6.0, solve=None) -> tuple[dict, pd.DataFrame]:
     """The campaign's diagnosis (the content of ``diagnosis.json``) and its comparison points
     (one row per observation: measured ``D``, the campaign model ``S_model`` and the model
-    with every found effect at its calibrated value ``S_final``)."""
+    with every found effect at its calibrated value ``S_final``).
+
+    With ``solve`` (variants -> table rows of every specimen, ``hdwf.campaign.solve_specimens``)
+    every effect switched on before a round (calibrated first, or found in the previous round)
+    is recalibrated on actual solves around its estimate (``refine_fit``), so that the next
+    round's candidates are weighed against the model, not against the table's interpolation
+    error; after the last round the ladder's actual solves check the result. Without
+    ``solve``, the tables' splines serve throughout."""
     from .campaign import candidate_names
 
     fixed = dict(fixed or {})
@@ -339,14 +431,21 @@ def diagnose(meas, table: pd.DataFrame, fixed: dict | None = None, calibrate_fir
         raise RuntimeError(f"the campaign model failed to solve for specimen(s) {', '.join(bad)}; "
                            "see their tables' status")
     notes: dict[str, str] = {}
+    refinement: dict[str, str] = {}
     resp = responses(table, obs, fixed, candidates, notes)
+    table_resp = dict(resp)        # the tables' splines; ``resp`` may get refined ones
     candidates = [c for c in candidates if c in resp]
+
+    def refined(fit: Fit) -> Fit:
+        return refine_fit(D, S0, resp, table_resp, fit, solve, obs, fixed, refinement) if solve else fit
 
     on: list[str] = []
     fit = Fit([], np.zeros(0), np.zeros((0, 0)), S0, float(np.sum((S0 - D) ** 2)), len(D))
     for e in calibrate_first:                        # effects the campaign says to calibrate
         on.append(e)
         fit = calibrate(D, S0, resp, on, start=list(fit.t))
+    if on:
+        fit = refined(fit)
     rounds = []
     remaining = [c for c in candidates if c not in on]
     for rnd in range(1, max_rounds + 1):
@@ -377,10 +476,11 @@ def diagnose(meas, table: pd.DataFrame, fixed: dict | None = None, calibrate_fir
         if winner is None:
             break
         on.append(winner)
-        fit = extra[winner]["fit"]
         remaining.remove(winner)
-        if not remaining:
+        fit = extra[winner]["fit"]
+        if not remaining or rnd == max_rounds:
             break
+        fit = refined(fit)      # the next round's candidates are calibrated on top of it
 
     base_points = comparison_points(_measured_for_points(obs), _predicted_for_points(obs, S0), "value")
     for c in meas.specimens.columns:
@@ -398,7 +498,7 @@ def diagnose(meas, table: pd.DataFrame, fixed: dict | None = None, calibrate_fir
         sigma = float(np.sqrt(fit.rss / max(len(D) - len(on), 1)))
         sigma_from = "the residual of the final model (no noise stated: an upper bound on the noise)"
     units = meas.units
-    seen = detectability(resp, sigma, len(D), units[0] if len(units) == 1 else None, pay_threshold)
+    seen = detectability(table_resp, sigma, len(D), units[0] if len(units) == 1 else None, pay_threshold)
     points = obs.copy()
     points["S_model"] = S0
     points["S_final"] = fit.S
@@ -427,6 +527,7 @@ def diagnose(meas, table: pd.DataFrame, fixed: dict | None = None, calibrate_fir
         "final": {"effects": fit.params(resp), "rmse_arcmin": final_rmse,
                   "rmse_over_noise": (final_rmse / noise) if noise else None},
         "notes": notes,
+        "refinement": refinement,
         "worst_specimens": per.head(5).to_dict(orient="records"),
         "per_specimen": per.to_dict(orient="records"),
         "residual_tests": tests.to_dict(orient="records"),
@@ -504,14 +605,23 @@ def json_safe(obj):
 
 # ------------------------------------------------------------------ workflow stages
 
-def diagnosis_stage(measurements_path, table_paths, plan, out_json, out_points, provenance: dict) -> dict:
-    """Diagnose one campaign from its measurement file and per-specimen tables."""
+def diagnosis_stage(measurements_path, table_paths, plan, out_json, out_points, provenance: dict,
+                    jobs: int = 1) -> dict:
+    """Diagnose one campaign from its measurement file and per-specimen tables; the solves
+    that anchor an effect found before the next round run here, in ``jobs`` processes."""
+    from .campaign import solve_specimens
     from .io import write_json, write_parquet
     from .measurements import load_measurements
 
     meas = load_measurements(measurements_path)
     table = pd.concat([pd.read_parquet(p) for p in table_paths], ignore_index=True)
-    result, points = diagnose(meas, table, plan.fixed, plan.calibrate_first, plan.candidates, plan.rounds)
+
+    def solve(variants):
+        return solve_specimens(plan.unit, meas.specimens, plan.settings, plan.steps_per_ramp,
+                               lambda _: variants, jobs)
+
+    result, points = diagnose(meas, table, plan.fixed, plan.calibrate_first, plan.candidates, plan.rounds,
+                              solve=solve)
     result = {"campaign": plan.name, "unit": plan.unit, "measurements": str(measurements_path),
               "mesh": plan.settings, **result, "provenance": provenance}
     write_parquet(points, out_points, provenance=provenance, meta={"campaign": plan.name, "unit": plan.unit})

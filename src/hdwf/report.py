@@ -565,6 +565,13 @@ def _validation_section(doc: Document, campaign: str, files: dict, level: int = 
             if best.get("at_bound"):
                 txt += " Its best value sits on the bound of its range: treat it as a stand-in, not an explanation."
             doc.text(txt)
+    for name, note in diag.get("refinement", {}).items():
+        if name == "unsettled":
+            doc.text(f"Caution: {lit(note)}.")
+        else:
+            doc.text(f"Before the next round, {lit(name)} was recalibrated on actual FE solves near its estimate, so "
+                     f"that round weighs its candidates against the FE model, not against the table's interpolation "
+                     f"error: {lit(note)}.")
     _detectability_part(doc, diag, level + 1)
     doc.heading("Adding it: the error ladder", level + 1)
     doc.table(["rung", "model", "RMSE", "bias", "largest |E|", "ΔBIC"],

@@ -86,6 +86,12 @@ rule validation_diagnosis:
     params:
         plan=plan_dict,
         repo=REPO_DIR,
+    # an effect found before the next round is re-solved near its estimate, every specimen
+    threads: 2
+    resources:
+        mem_mb=8000,
+    benchmark:
+        "results/validation/{campaign}/benchmarks/diagnosis.tsv"
     log:
         "results/logs/validation_{campaign}_diagnosis.log",
     script:

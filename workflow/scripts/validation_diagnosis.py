@@ -6,8 +6,11 @@ from _adapter import setup  # noqa: E402
 from hdwf.campaign import CampaignPlan  # noqa: E402
 from hdwf.diagnosis import diagnosis_stage  # noqa: E402
 
-prov = setup(snakemake)  # noqa: F821
-plan = CampaignPlan(**snakemake.params.plan)  # noqa: F821
-result = diagnosis_stage(snakemake.input.measurements, snakemake.input.tables, plan,  # noqa: F821
-                         snakemake.output.json, snakemake.output.points, prov)  # noqa: F821
-logging.info("verdict: %s", result["verdict"])
+# guarded: the re-solves before a further round run in spawned processes, which import this file
+if __name__ == "__main__":
+    prov = setup(snakemake)  # noqa: F821
+    plan = CampaignPlan(**snakemake.params.plan)  # noqa: F821
+    result = diagnosis_stage(snakemake.input.measurements, snakemake.input.tables, plan,  # noqa: F821
+                             snakemake.output.json, snakemake.output.points, prov,  # noqa: F821
+                             jobs=snakemake.threads)  # noqa: F821
+    logging.info("verdict: %s", result["verdict"])
