@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from hdwf.campaign import (add_noise, design_ranges, format_ranges, mean_lost_motion, parse_range,
-                           plan_variants, solve_specimens, synth_curves, synth_designs)
+                           plan_variants, specimen_solver, synth_curves, synth_designs)
 from hdwf.diagnosis import diagnose
 from hdwf.effects import registry
 from hdwf.io import atomic_path
@@ -57,7 +57,7 @@ def main():
     t0 = time.perf_counter()
     specimens = synth_designs(UNIT, args.specimens, DESIGN_SEED, ranges)
     plan = plan_variants({})
-    tables = solve_specimens(UNIT, specimens, SETTINGS, args.steps_per_ramp, lambda _: plan, jobs=args.jobs)
+    tables = specimen_solver(UNIT, specimens, SETTINGS, args.steps_per_ramp, args.jobs)(plan)
     signal = mean_lost_motion(tables)
     print(f"tables: {time.perf_counter() - t0:.0f} s; mean lost motion {signal:.3f} arcmin")
 

@@ -162,11 +162,11 @@ def _kinked_thermal(n_points=60, seed=5):
 
 def test_anchoring_on_actual_solves_removes_the_tables_interpolation_error():
     """Between the thermal grid's values (every 10 K) kinks make the table's spline wrong: a
-    calibration on it misses dT = 17 K of noise-free data. Anchored on exact solves around its
-    estimate (three per move), the response is exact there (straight between the kinks, so
-    the quadratic through the three is exact) and the calibration recovers 17 K; the log names
-    where it solved."""
-    from hdwf.diagnosis import Fit, calibrate, refine_fit, responses
+    calibration on it misses dT = 17 K of noise-free data by 0.19 K. Anchored on exact solves
+    around its estimate (three, in one call), the response is exact there (straight between
+    the kinks, so the quadratic through the three is exact) and the calibration recovers
+    17 K; the log says where it solved."""
+    from hdwf.diagnosis import calibrate, refine_fit, responses
 
     table, obs, twist, solve, calls = _kinked_thermal()
     resp = responses(table, obs, {}, ["thermal"])
@@ -175,12 +175,91 @@ def test_anchoring_on_actual_solves_removes_the_tables_interpolation_error():
     plain = calibrate(D, S0, resp, ["thermal"])
     assert abs(plain.t[0] - 17.0) > 0.1           # the spline's error shows in the estimate (0.19 K)
     log = {}
-    table_resp = dict(resp)
-    fit = refine_fit(D, S0, resp, table_resp, plain, solve, obs, {}, log)
-    assert isinstance(fit, Fit) and fit.t[0] == pytest.approx(17.0, abs=1e-6)
+    fit = refine_fit(D, S0, resp, dict(resp), plain, solve, obs, {}, log, before_round=2)
+    assert fit.t[0] == pytest.approx(17.0, abs=1e-6)
     assert fit.rss == pytest.approx(0.0, abs=1e-16)
-    assert calls and all(c == 3 for c in calls)
+    assert calls == [3]
     lo, hi = resp["thermal"].anchor[0][[0, -1]]
     assert lo <= 17.0 <= hi and hi - lo == pytest.approx(2.0)     # ± a tenth of the 10 K spacing
-    assert "actual solves at delta_T_K" in log["thermal"]
-    assert table_resp["thermal"].anchor is None                   # the table's response is kept
+    assert log["thermal"]["status"] == "anchored" and log["thermal"]["before_round"] == 2
+    assert log["thermal"]["solved_at"] == pytest.approx([lo, (lo + hi) / 2, hi])
+
+
+def test_an_anchored_response_is_exact_at_the_grid_and_off_at_zero():
+    """Outside its solved interval the anchored response is the table's spline shifted to meet
+    the solves, the shift fading to zero at the next grid value: it stays continuous at the
+    interval's ends and equals the table (an actual solve) at every grid value, so t = 0
+    still means "off"."""
+    from hdwf.diagnosis import anchored_responses, responses
+
+    table, obs, twist, solve, _ = _kinked_thermal()
+    resp = responses(table, obs, {}, ["thermal"])["thermal"]
+    anchored = anchored_responses({"thermal": resp}, {"thermal": 16.3}, solve, obs, {})["thermal"]
+    for t in resp.t:                                   # the grid, incl. 0 and the bounds
+        np.testing.assert_allclose(anchored.change(t), resp.change(t), atol=1e-12)
+    np.testing.assert_allclose(anchored.change(0.0), 0.0, atol=1e-12)
+    for edge in anchored.anchor[0][[0, -1]]:             # continuous where the quadratic ends
+        np.testing.assert_allclose(anchored.change(edge - 1e-9), anchored.change(edge + 1e-9), atol=1e-9)
+        exact = twist({"thermal": {"delta_T_K": edge}}) - twist({})
+        np.testing.assert_allclose(anchored.change(edge), exact, atol=1e-12)
+
+
+def test_a_failed_anchor_solve_keeps_the_table_and_says_so():
+    """A solve that raises, or returns a failed status, must not lose the diagnosis: the
+    table's response is kept, the estimate is the table's, and the log names the failure."""
+    from hdwf.diagnosis import calibrate, refine_fit, responses
+
+    table, obs, twist, solve, _ = _kinked_thermal()
+    S0, D = twist({}), twist({"thermal": {"delta_T_K": 17.0}})
+
+    def crashes(variants):
+        raise RuntimeError("worker died")
+
+    def fails(variants):
+        out = solve(variants)
+        out["twist_arcmin"], out["status"] = np.nan, "failed: no convergence"
+        return out
+
+    for bad, reason in ((crashes, "RuntimeError: worker died"), (fails, "failed: no convergence")):
+        resp = responses(table, obs, {}, ["thermal"])
+        plain = calibrate(D, S0, resp, ["thermal"])
+        log = {}
+        fit = refine_fit(D, S0, resp, dict(resp), plain, bad, obs, {}, log, before_round=2)
+        assert fit.t[0] == plain.t[0] and resp["thermal"].anchor is None
+        assert log["thermal"]["status"] == "failed" and reason in log["thermal"]["reason"]
+        assert "the table's response is used" in log["thermal"]["reason"]
+
+
+def test_anchor_points_of_a_stiffness_stay_inside_its_values():
+    """Housing stiffness is tabulated in t = k^-3/4, where t = 0 ("off", k infinite) is not
+    a value: an estimate at or near 0 is solved at three finite stiffnesses within the
+    parameter's bounds, in increasing t, a tenth of the grid spacing apart."""
+    from hdwf.diagnosis import Response, anchor_points
+    from hdwf.effects import get
+
+    p = get("cs_housing").param("k_N_per_mm2")
+    lo, hi = p.t_bounds
+    resp = Response("cs_housing", p.name, np.array([lo, hi]), np.zeros((2, 1)), (lo, hi))
+    h = 0.1 * (hi - lo) / p.grid_points
+    for t_hat in (0.0, 1e-9, hi, 0.5 * hi):
+        ts, values = anchor_points(resp, t_hat)
+        assert np.all(np.diff(ts) > 0) and np.diff(ts) == pytest.approx([h, h])
+        assert all(p.lower <= v <= p.upper for v in values)
+
+
+def test_report_says_where_an_effect_was_re_solved():
+    """diagnosis.json's ``refinement`` in words: the values solved at, and a caution when a
+    solve failed (the sentence must not claim a recalibration that did not happen)."""
+    from hdwf.report import Document, _refinement_part
+
+    diag = {"refinement": {
+        "thermal": {"status": "anchored", "before_round": 2, "param": "delta_T_K",
+                    "solved_at": [10.1468, 11.1468, 12.1468], "solves": 1},
+        "cs_housing": {"status": "failed", "reason": "the solve failed (failed: no convergence); "
+                                                    "the table's response is used"}}}
+    doc = Document("t", "s", {})
+    _refinement_part(doc, diag)
+    texts = [b["text"] for b in doc.blocks]
+    assert len(texts) == 2
+    assert "Before round 2" in texts[0] and "10.1468, 11.1468, 12.1468" in texts[0]
+    assert texts[1].startswith("Caution") and "no convergence" in texts[1] and "recalibrated" not in texts[1]

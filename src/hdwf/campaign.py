@@ -143,6 +143,13 @@ def solve_specimens(unit: str, specimens: pd.DataFrame, settings: dict, steps_pe
     return pd.concat(out, ignore_index=True)
 
 
+def specimen_solver(unit: str, specimens: pd.DataFrame, settings: dict, steps_per_ramp: int, jobs: int = 1):
+    """``solve(variants)``: the same ``variants`` solved for every specimen (``solve_specimens``)."""
+    def solve(variants: list[dict]) -> pd.DataFrame:
+        return solve_specimens(unit, specimens, settings, steps_per_ramp, lambda _: variants, jobs)
+    return solve
+
+
 # ------------------------------------------------------------------ synthetic measurements
 
 def mean_lost_motion(table: pd.DataFrame, fixed: dict | None = None) -> float:
@@ -233,7 +240,7 @@ def synth_curves(unit: str, n_designs: int, seed: int, effects: dict[str, dict[s
     specimens = synth_designs(unit, n_designs, seed, ranges)
     effects = effects or {}
     model_changes(effects)    # checks names, parameters and bounds before any solve
-    table = solve_specimens(unit, specimens, settings, steps_per_ramp, lambda _: [effects], jobs)
+    table = specimen_solver(unit, specimens, settings, steps_per_ramp, jobs)([effects])
     bad = table[table["status"] != "ok"]
     if len(bad):
         raise RuntimeError(f"synthesis: the FE solve failed for specimen "

@@ -7,7 +7,9 @@ with that effect at each value of its parameter's grid.
 Method (hand-written around scipy/statsmodels; see docs/validation.md):
 
 * an effect's prediction at parameter t (its ``transform``: t = 0 is "off") is the cubic
-  spline through the tabulated values, point by point;
+  spline through the tabulated values, point by point; once an effect is found (and a further
+  round follows) it is solved at three values around its estimate and the prediction there
+  comes from those solves (``anchored_responses``, when ``diagnose`` is given a ``solve``);
 * effects found earlier stay on; a new candidate is added by superposition of its change
   (exact when one of the two acts in series at the output, an approximation otherwise,
   which the ladder's actual solves check) and all switched-on parameters are calibrated
@@ -108,7 +110,7 @@ class Response:
     S: np.ndarray          # (len(t), n_obs)
     t_bounds: tuple[float, float]
     off: np.ndarray | None = None   # the prediction with the effect off (default: the row at t = 0)
-    # actual solves near an estimate: (their three t, their predictions), see anchored_response
+    # actual solves near an estimate: (their three t, their predictions), see anchored_responses
     anchor: tuple[np.ndarray, np.ndarray] | None = None
 
     def __post_init__(self):
@@ -120,6 +122,9 @@ class Response:
             ta, Sa = self.anchor
             self._local = make_interp_spline(ta, Sa, k=2, axis=0)
             self._shift = (Sa[0] - self._spline(ta[0]), Sa[-1] - self._spline(ta[-1]))
+            # the grid values next to the solved interval, where the shift has faded to zero
+            below, above = self.t[self.t < ta[0]], self.t[self.t > ta[-1]]
+            self._fade_to = (below.max() if below.size else None, above.min() if above.size else None)
 
     def change(self, t: float) -> np.ndarray:
         """Prediction at t minus the prediction with the effect off."""
@@ -129,8 +134,12 @@ class Response:
         ta = self.anchor[0]
         if ta[0] <= t <= ta[-1]:        # the quadratic through the actual solves
             return self._local(t) - self.off
-        # outside: the spline, shifted to meet them (continuous at both ends)
-        return self._spline(t) + self._shift[0 if t < ta[0] else 1] - self.off
+        # outside: the spline, shifted to meet them (continuous at both ends), the shift
+        # fading linearly to zero at the next grid value (the spline is exact there)
+        side = 0 if t < ta[0] else 1
+        edge, grid = ta[0 if side == 0 else -1], self._fade_to[side]
+        w = 1.0 if grid is None else min(max((t - grid) / (edge - grid), 0.0), 1.0)
+        return self._spline(t) + w * self._shift[side] - self.off
 
     def value(self, t: float) -> float:
         return get_effect(self.effect).param(self.param).from_t(t)
@@ -244,73 +253,108 @@ def calibrate(D: np.ndarray, S0: np.ndarray, resp: dict[str, Response], effects:
     return Fit(list(effects), t, cov, S, float(r @ r), n)
 
 
-# Refinement by actual solves: around an estimate t the response is solved at t - h, t, t + h,
-# h this share of the table's grid spacing; the estimate may leave that interval this often.
+# Recalibration on actual solves: around an estimate t the response is solved at t - h, t and
+# t + h, h this share of the table's grid spacing; at most this many solves per effect.
 ANCHOR_HALF_WIDTH = 0.1
-ANCHOR_MOVES = 4
+ANCHOR_SOLVES = 4
 
 
-def anchored_response(table_resp: Response, t_hat: float, solve, obs: pd.DataFrame,
-                      fixed: dict) -> Response | None:
-    """The table's response of one effect anchored to actual solves at t_hat - h, t_hat and
-    t_hat + h (h = ``ANCHOR_HALF_WIDTH`` of the grid spacing): between them the quadratic
-    through the three solves, outside the table's spline shifted to meet it.
+def anchor_points(table_resp: Response, t_hat: float) -> tuple[np.ndarray, list[float]] | None:
+    """The three t (and parameter values) to solve around ``t_hat``: t_hat - h, t_hat, t_hat + h,
+    h = ``ANCHOR_HALF_WIDTH`` of the table's grid spacing, moved inside the range of the
+    parameter's values (for a reciprocal transform t = 0, "off", is not a value); None when
+    that range is narrower than 2h."""
+    p = get_effect(table_resp.effect).param(table_resp.param)
+    lo, hi = p.t_bounds
+    h = ANCHOR_HALF_WIDTH * (hi - lo) / p.grid_points
+    vlo, vhi = sorted((p.to_t(p.lower), p.to_t(p.upper)))
+    if vhi - vlo < 2 * h:
+        return None
+    centre = min(max(float(t_hat), vlo + h), vhi - h)
+    values = [p.clip(p.from_t(t)) for t in (centre - h, centre, centre + h)]
+    ts = np.array([p.to_t(v) for v in values])
+    return (ts, values) if np.all(np.diff(ts) > 0) else None
+
+
+def anchored_responses(table_resp: dict[str, Response], t_hat: dict[str, float], solve, obs: pd.DataFrame,
+                       fixed: dict) -> dict[str, Response | str]:
+    """Each effect's table response anchored to actual solves at its ``anchor_points``: between
+    the three, the quadratic through them; outside, the table's spline shifted to meet them,
+    the shift fading to zero at the next grid value (where the spline is exact anyway).
+    One ``solve`` call for all effects (one mesh per specimen); an effect whose solve failed
+    gets the reason instead of a response.
 
     Why: a spline through the table's grid is off by up to a few hundredths of an arcmin where
     tooth pairs close between two grid values (thermal near zero clearance,
     docs/validation.md); with thousands of readings that is enough to tip two look-alike
-    candidates in the next round, whose joint fits move this estimate by up to about h.
-    ``solve(variants)`` returns the table rows of every specimen for those variants. Returns
-    None when a solve failed (the table's response is then kept)."""
-    p = get_effect(table_resp.effect).param(table_resp.param)
-    lo, hi = table_resp.t_bounds
-    h = ANCHOR_HALF_WIDTH * float(np.min(np.diff(table_resp.t)))
-    centre = min(max(float(t_hat), lo + h), hi - h)
-    values = [min(max(p.from_t(t), p.lower), p.upper) for t in (centre - h, centre, centre + h)]
-    variants = [{**fixed, table_resp.effect: {p.name: v}} for v in values]
-    tab = solve(variants)
-    ts = np.array([p.to_t(v) for v in values])
-    S = np.array([predict(tab, obs, variant_key(v)) for v in variants])
-    if not np.isfinite(S).all():
-        return None
-    return Response(table_resp.effect, table_resp.param, table_resp.t, table_resp.S, table_resp.t_bounds,
-                    off=table_resp.off, anchor=(ts, S))
+    candidates in the next round. ``solve(variants)`` returns the table rows of every
+    specimen for those variants."""
+    out: dict[str, Response | str] = {}
+    plan = {}
+    for e, t in t_hat.items():
+        pts = anchor_points(table_resp[e], t)
+        if pts is None:
+            out[e] = "its range is too narrow to solve around the estimate"
+        else:
+            pname = table_resp[e].param
+            plan[e] = (pts[0], [{**fixed, e: {pname: v}} for v in pts[1]])
+    if not plan:
+        return out
+    try:
+        tab = solve([v for _, vs in plan.values() for v in vs])
+    except Exception as exc:          # a crashed solve must not lose the diagnosis
+        return {**out, **{e: f"the solve failed ({type(exc).__name__}: {exc})" for e in plan}}
+    for e, (ts, variants) in plan.items():
+        S = np.array([predict(tab, obs, variant_key(v)) for v in variants])
+        if not np.isfinite(S).all():
+            bad = sorted(set(tab.loc[tab["status"] != "ok", "status"]))
+            out[e] = "the solve failed" + (f" ({bad[0]})" if bad else "")
+            continue
+        r = table_resp[e]
+        out[e] = Response(r.effect, r.param, r.t, r.S, r.t_bounds, off=r.off, anchor=(ts, S))
+    return out
 
 
 def refine_fit(D, S0, resp: dict, table_resp: dict, fit: Fit, solve, obs, fixed: dict,
-               log: dict) -> Fit:
+               log: dict, before_round: int) -> Fit:
     """Anchor the response of every switched-on effect that needs a contact solve to actual
-    solves around its calibrated value (``anchored_response``) and recalibrate, until every
-    estimate sits inside its solved interval (or on the parameter's bound). Series effects
-    are exact in the table (their twist adds to the solved one) and are not anchored.
-    ``log`` gets one sentence per effect: where it was solved, or why the table was kept."""
-    on, failed = fit.effects, set()
-    for move in range(ANCHOR_MOVES + 1):
-        stale = []
+    solves around its calibrated value (``anchored_responses``; ``resp`` is updated in place)
+    and recalibrate, until no estimate leaves its solved interval. Series effects are exact in
+    the table (their twist adds to the solved one) and are not anchored. ``log[effect]``
+    records where it was solved, or why the table (or the last anchor) was kept."""
+    on, done = fit.effects, set()
+    for n_solve in range(1, ANCHOR_SOLVES + 2):
+        stale = {}
         for k, e in enumerate(on):
-            if get_effect(e).series or e in failed:
+            if get_effect(e).series or e in done:
                 continue
             a, t = resp[e].anchor, fit.t[k]
-            lo, hi = table_resp[e].t_bounds
-            if a is None or not (a[0][0] <= t <= a[0][-1] or t <= lo or t >= hi):
-                stale.append(e)
+            if a is not None:
+                pts = anchor_points(table_resp[e], t)
+                # inside the solved interval, or pinned where the last anchor was (a bound)
+                if a[0][0] <= t <= a[0][-1] or (pts is not None and np.array_equal(pts[0], a[0])):
+                    continue
+            stale[e] = t
         if not stale:
             return fit
-        if move == ANCHOR_MOVES:
-            log["unsettled"] = (f"the estimate of {', '.join(stale)} still left its solved interval after "
-                                f"{ANCHOR_MOVES} moves; the last anchored response is used")
+        if n_solve > ANCHOR_SOLVES:
+            for e in stale:
+                log[e]["status"] = "unsettled"
+                log[e]["reason"] = (f"the estimate still left its solved interval after {ANCHOR_SOLVES} "
+                                    "solves; the last anchored response is used")
             return fit
-        for e in stale:
-            r = anchored_response(table_resp[e], fit.t[on.index(e)], solve, obs, fixed)
-            if r is None:
-                log[e] = "a solve near its estimate failed; the table's response is used"
-                resp[e] = table_resp[e]
-                failed.add(e)
+        changed = False
+        for e, r in anchored_responses(table_resp, stale, solve, obs, fixed).items():
+            if isinstance(r, str):
+                done.add(e)
+                kept = "the last anchored response" if resp[e].anchor is not None else "the table's response"
+                log[e] = {**log.get(e, {}), "status": "failed", "reason": f"{r}; {kept} is used"}
                 continue
-            resp[e] = r
-            log[e] = (f"calibrated on the table corrected by actual solves at {table_resp[e].param} = "
-                      + ", ".join(f"{r.value(t):.6g}" for t in r.anchor[0]))
-        fit = calibrate(D, S0, resp, on, start=list(fit.t))
+            resp[e], changed = r, True
+            log[e] = {"status": "anchored", "before_round": before_round, "param": r.param,
+                      "solved_at": [r.value(t) for t in r.anchor[0]], "solves": n_solve}
+        if changed:
+            fit = calibrate(D, S0, resp, on, start=list(fit.t))
     return fit
 
 
@@ -367,13 +411,13 @@ def plan_detectability(unit: str, specimens: pd.DataFrame, settings: dict, steps
     Solves the campaign tables of ``specimens`` (the baseline model and every candidate's
     grid, as a campaign would) and evaluates ``detectability`` on the curve form of the
     test (every step of every specimen) with ``noise_arcmin`` per point."""
-    from .campaign import candidate_names, plan_variants, solve_specimens
+    from .campaign import candidate_names, plan_variants, specimen_solver
 
     if not (noise_arcmin > 0 and math.isfinite(noise_arcmin)):
         raise ValueError(f"noise_arcmin must be > 0, got {noise_arcmin!r}")
     candidates = candidate_names({}) if candidates is None else list(candidates)
     plan = plan_variants({}, candidates)
-    table = solve_specimens(unit, specimens, settings, steps_per_ramp, lambda _: plan, jobs)
+    table = specimen_solver(unit, specimens, settings, steps_per_ramp, jobs)(plan)
     return detectability_of_tables(table, unit, noise_arcmin, candidates, pay_threshold)
 
 
@@ -409,12 +453,13 @@ def diagnose(meas, table: pd.DataFrame, fixed: dict | None = None, calibrate_fir
     (one row per observation: measured ``D``, the campaign model ``S_model`` and the model
     with every found effect at its calibrated value ``S_final``).
 
-    With ``solve`` (variants -> table rows of every specimen, ``hdwf.campaign.solve_specimens``)
+    With ``solve`` (variants -> table rows of every specimen, ``hdwf.campaign.specimen_solver``)
     every effect switched on before a round (calibrated first, or found in the previous round)
-    is recalibrated on actual solves around its estimate (``refine_fit``), so that the next
-    round's candidates are weighed against the model, not against the table's interpolation
-    error; after the last round the ladder's actual solves check the result. Without
-    ``solve``, the tables' splines serve throughout."""
+    that needs a contact solve (not the series ones, exact in the tables) is recalibrated on
+    actual solves around its estimate (``refine_fit``), so that the round's candidates are
+    weighed against the FE model, not against the tables' interpolation error; after the last
+    round the ladder's actual solves check the result. Without ``solve``, the tables' splines
+    serve throughout. ``refinement`` in the result says what was solved where."""
     from .campaign import candidate_names
 
     fixed = dict(fixed or {})
@@ -431,13 +476,15 @@ def diagnose(meas, table: pd.DataFrame, fixed: dict | None = None, calibrate_fir
         raise RuntimeError(f"the campaign model failed to solve for specimen(s) {', '.join(bad)}; "
                            "see their tables' status")
     notes: dict[str, str] = {}
-    refinement: dict[str, str] = {}
+    refinement: dict[str, dict] = {}
     resp = responses(table, obs, fixed, candidates, notes)
     table_resp = dict(resp)        # the tables' splines; ``resp`` may get refined ones
     candidates = [c for c in candidates if c in resp]
 
-    def refined(fit: Fit) -> Fit:
-        return refine_fit(D, S0, resp, table_resp, fit, solve, obs, fixed, refinement) if solve else fit
+    def refined(fit: Fit, before_round: int) -> Fit:
+        if solve is None:
+            return fit
+        return refine_fit(D, S0, resp, table_resp, fit, solve, obs, fixed, refinement, before_round)
 
     on: list[str] = []
     fit = Fit([], np.zeros(0), np.zeros((0, 0)), S0, float(np.sum((S0 - D) ** 2)), len(D))
@@ -445,7 +492,7 @@ def diagnose(meas, table: pd.DataFrame, fixed: dict | None = None, calibrate_fir
         on.append(e)
         fit = calibrate(D, S0, resp, on, start=list(fit.t))
     if on:
-        fit = refined(fit)
+        fit = refined(fit, 1)
     rounds = []
     remaining = [c for c in candidates if c not in on]
     for rnd in range(1, max_rounds + 1):
@@ -469,7 +516,9 @@ def diagnose(meas, table: pd.DataFrame, fixed: dict | None = None, calibrate_fir
             x = extra[r["effect"]]
             r.update({"param_sd": None if x["off"] else x["param_sd"],
                       "signature_match": x["signature_match"], "at_bound": x["at_bound"],
-                      "calibrated_off": x["off"], "signature": get_effect(r["effect"]).signature})
+                      "calibrated_off": x["off"], "signature": get_effect(r["effect"]).signature,
+                      # the effects already on, recalibrated jointly with this candidate
+                      "with_effects": {k: v for k, v in x["fit"].params(resp).items() if k != r["effect"]}})
         rounds.append({"round": rnd, "model_effects": list(on), "current_rmse_arcmin": cur.rmse,
                        "ranking": v["ranking"], "verdict": v["verdict"]})
         winner = v["verdict"]["missing_effect"]
@@ -480,7 +529,7 @@ def diagnose(meas, table: pd.DataFrame, fixed: dict | None = None, calibrate_fir
         fit = extra[winner]["fit"]
         if not remaining or rnd == max_rounds:
             break
-        fit = refined(fit)      # the next round's candidates are calibrated on top of it
+        fit = refined(fit, rnd + 1)      # the next round's candidates are calibrated on top of it
 
     base_points = comparison_points(_measured_for_points(obs), _predicted_for_points(obs, S0), "value")
     for c in meas.specimens.columns:
@@ -609,17 +658,14 @@ def diagnosis_stage(measurements_path, table_paths, plan, out_json, out_points, 
                     jobs: int = 1) -> dict:
     """Diagnose one campaign from its measurement file and per-specimen tables; the solves
     that anchor an effect found before the next round run here, in ``jobs`` processes."""
-    from .campaign import solve_specimens
+    from .campaign import specimen_solver
     from .io import write_json, write_parquet
     from .measurements import load_measurements
 
     meas = load_measurements(measurements_path)
     table = pd.concat([pd.read_parquet(p) for p in table_paths], ignore_index=True)
 
-    def solve(variants):
-        return solve_specimens(plan.unit, meas.specimens, plan.settings, plan.steps_per_ramp,
-                               lambda _: variants, jobs)
-
+    solve = specimen_solver(plan.unit, meas.specimens, plan.settings, plan.steps_per_ramp, jobs)
     result, points = diagnose(meas, table, plan.fixed, plan.calibrate_first, plan.candidates, plan.rounds,
                               solve=solve)
     result = {"campaign": plan.name, "unit": plan.unit, "measurements": str(measurements_path),

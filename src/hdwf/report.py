@@ -501,6 +501,18 @@ def _detectability_part(doc: Document, diag: dict, level: int):
                "is explained."))
 
 
+def _refinement_part(doc: Document, diag: dict):
+    """Which found effects the diagnosis re-solved before a further round, and where."""
+    for name, r in diag.get("refinement", {}).items():
+        if r.get("solved_at"):
+            at = ", ".join(f"{v:.6g}" for v in r["solved_at"])
+            doc.text(f"Before round {r['before_round']}, {lit(name)} was recalibrated on actual FE solves of every "
+                     f"specimen at {lit(r['param'])} = {at} (solve {r['solves']}), so that round weighs its candidates "
+                     "against the FE model, not against the interpolation error of the tabulated values.")
+        if r["status"] in ("failed", "unsettled"):
+            doc.text(f"Caution, {lit(name)}: {lit(r['reason'])}.")
+
+
 def _validation_section(doc: Document, campaign: str, files: dict, level: int = 2):
     diag = json.loads(Path(files["diagnosis"]).read_text())
     ladder = pd.read_parquet(files["ladder"])
@@ -565,13 +577,7 @@ def _validation_section(doc: Document, campaign: str, files: dict, level: int = 
             if best.get("at_bound"):
                 txt += " Its best value sits on the bound of its range: treat it as a stand-in, not an explanation."
             doc.text(txt)
-    for name, note in diag.get("refinement", {}).items():
-        if name == "unsettled":
-            doc.text(f"Caution: {lit(note)}.")
-        else:
-            doc.text(f"Before the next round, {lit(name)} was recalibrated on actual FE solves near its estimate, so "
-                     f"that round weighs its candidates against the FE model, not against the table's interpolation "
-                     f"error: {lit(note)}.")
+    _refinement_part(doc, diag)
     _detectability_part(doc, diag, level + 1)
     doc.heading("Adding it: the error ladder", level + 1)
     doc.table(["rung", "model", "RMSE", "bias", "largest |E|", "ΔBIC"],

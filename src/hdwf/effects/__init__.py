@@ -62,13 +62,17 @@ class Parameter:
         lo, hi = min(a, b), max(a, b)
         return (min(lo, 0.0), max(hi, 0.0))
 
+    def clip(self, value: float) -> float:
+        """``value`` held within [lower, upper] (a value from ``from_t`` may round past a bound)."""
+        return min(max(float(value), self.lower), self.upper)
+
     def grid(self) -> list[float]:
         """Parameter values to tabulate: evenly spaced in t over the bounds, without "off"."""
         lo, hi = self.t_bounds
         n = self.grid_points
         ts = [lo + (hi - lo) * k / n for k in range(n + 1)]
         # clipped: the ends must be the bounds themselves, not their rounded round trip
-        return [min(max(self.from_t(t), self.lower), self.upper) for t in ts if t != 0.0]
+        return [self.clip(self.from_t(t)) for t in ts if t != 0.0]
 
     def check(self, value: float, where: str) -> float:
         v = float(value)
