@@ -114,8 +114,11 @@ def test_validation_campaign_chain(tmp_path):
     assert diag["verdict"]["missing_effect"] == "thermal"      # the demo data hide 12 K
     assert diag["ranking"][0]["effect"] == "thermal" and diag["baseline"]["rmse_arcmin"] > 0.1
     assert set(diag["ranking"][0]) >= {"effect", "params", "rmse_arcmin", "delta_bic"}
-    # before round 2 the diagnosis job re-solved thermal around its estimate (2 processes)
-    assert "actual solves at delta_T_K" in diag["refinement"]["thermal"], diag["refinement"]
+    # before round 2 the diagnosis job re-solved thermal around its estimate, once
+    assert diag["refinement"]["thermal"]["status"] == "anchored", diag["refinement"]
+    assert diag["refinement"]["thermal"]["before_round"] == 2 and diag["refinement"]["thermal"]["solves"] == 1
+    lo, mid, hi = diag["refinement"]["thermal"]["solved_at"]
+    assert mid - lo == pytest.approx(1.0) and hi - mid == pytest.approx(1.0)   # a tenth of the 10 K grid
     assert len(diag["rounds"]) == 2
     ladder = pd.read_parquet(ws / target)
     assert list(ladder["model"]) == ["baseline", "with thermal"]

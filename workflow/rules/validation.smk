@@ -99,8 +99,8 @@ rule validation_diagnosis:
 
 
 rule validation_ladder:
-    # one job per campaign: a rung needs one or two solves per specimen, fewer seconds than
-    # a job per specimen spends starting up
+    # one job per campaign (a rung needs one or two solves per specimen, fewer seconds than
+    # a job per specimen spends starting up), its specimens in 2 processes
     input:
         measurements=lambda w: CAMPAIGNS[w.campaign].measurements,
         diagnosis="results/validation/{campaign}/diagnosis.json",
@@ -113,7 +113,7 @@ rule validation_ladder:
         settings=lambda w: CAMPAIGNS[w.campaign].settings,
         steps_per_ramp=lambda w: CAMPAIGNS[w.campaign].steps_per_ramp,
         repo=REPO_DIR,
-    threads: 1
+    threads: 2
     resources:
         mem_mb=4000,
     benchmark:

@@ -6,8 +6,11 @@ from _adapter import setup  # noqa: E402
 
 from hdwf.diagnosis import ladder_stage  # noqa: E402
 
-prov = setup(snakemake)  # noqa: F821
-p = snakemake.params  # noqa: F821
-ladder = ladder_stage(snakemake.input.measurements, snakemake.input.diagnosis, snakemake.input.tables,  # noqa: F821
-                      snakemake.output[0], prov, p.unit, dict(p.settings), p.steps_per_ramp)  # noqa: F821
-logging.info("\n%s", ladder.to_string())
+# guarded: the solves run in spawned processes, which import this file
+if __name__ == "__main__":
+    prov = setup(snakemake)  # noqa: F821
+    p = snakemake.params  # noqa: F821
+    ladder = ladder_stage(snakemake.input.measurements, snakemake.input.diagnosis,  # noqa: F821
+                          snakemake.input.tables, snakemake.output[0], prov, p.unit,  # noqa: F821
+                          dict(p.settings), p.steps_per_ramp, jobs=snakemake.threads)  # noqa: F821
+    logging.info("\n%s", ladder.to_string())
