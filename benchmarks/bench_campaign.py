@@ -27,7 +27,7 @@ from _workspace import ROOT, copy_workflow  # noqa: E402
 BIN = Path(sys.executable).parent
 
 
-def one_run(data: Path, n: int) -> tuple[float, dict, list[float]]:
+def one_run(data: Path, n: int) -> tuple[float, dict, list[float], dict[str, float]]:
     with tempfile.TemporaryDirectory(prefix="hdwf-bench-") as tmp:
         tmp = Path(tmp)
         copy_workflow(tmp)
