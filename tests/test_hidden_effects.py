@@ -20,8 +20,9 @@ over all points (diagnosis.detectability).
   claimed; no hidden effect gives no verdict.
 * A catalogue-grade batch: tight bearing fits (d within 4 µm over its 31 mm, D within 4 µm
   under 42 mm), the smallest radial clearance of Table 3 (5 to 8 µm) and tooth offsets within
-  2 µm of the zero-backlash design. Its lost motion is about 1.15 arcmin: a catalogue unit's 1
-  arcmin, inside the paper's HD 42 range (0.18 to 1.49). Curves of 401 points (100 steps per
+  2 µm of the zero-backlash design. Its lost motion is about 1.15 arcmin on average (0.46 to
+  1.94 over the specimens): a catalogue unit's 1 arcmin, inside the paper's HD 42 range (0.18
+  to 1.49). Curves of 401 points (100 steps per
   ramp, a bench logging continuously); 2 % noise is 0.023 arcmin (1.4 arcsec) per reading.
   Cup torsion and housing compliance are found and recovered within 15 %, and so is flank
   friction at mu 0.1 (expected sd 7 %). Two hidden effects (temperature, cup) are found in
@@ -29,7 +30,7 @@ over all points (diagnosis.detectability).
   (``diagnose(..., solve=...)``, as the workflow does).
 * Flank friction changes the curves by 0.003 arcmin RMS, whatever the batch: our section's
   flanks barely slide (docs/validation.md). It shows only where the noise is small in
-  absolute terms, so only on the tight batch. At mu 0.08 its expected sd there is 9 %, and
+  absolute terms, so only on the tight batch. At mu 0.08 its expected sd there is 10 %, and
   noise seed 11 misses 15 % (0.0923, 15.4 % off; 4 of 5 seeds pass). The test therefore uses
   mu 0.1, the upper end of the lubricated-steel range 0.05 to 0.1. At 0.2 % noise on the
   design-space curves, the diagnosis must report it as unseen or found, never both.
@@ -66,7 +67,7 @@ REALISTIC = {
     "tooth_friction": ("mu", 0.08),
 }
 # on the batch: friction at the upper end of its realistic range (mu 0.05-0.1), where its
-# expected sd is 7 % rather than 9 % at 0.08 (module docstring)
+# expected sd is 7 % rather than 10 % at 0.08, where noise seed 11 misses 15 % (module docstring)
 BATCH_VALUES = {**REALISTIC, "tooth_friction": ("mu", 0.10)}
 
 
@@ -145,6 +146,7 @@ def _hidden_one(tmp_path, specimens, tables, effect, noise, steps=STEPS, ranges=
     # the diagnosis's own estimate agrees: this data can show the effect
     assert effect not in diag["verdict"]["could_not_see"], diag["detectability"]
     _check_found(diag, effect, param, true, meas, specimens, noise, steps)
+    return diag
 
 
 @pytest.mark.parametrize("effect", ["thermal", "oldham_play"])
@@ -158,9 +160,13 @@ def test_elastic_effect_found_at_two_percent_noise_on_a_dense_catalogue_grade_ba
     """A batch of catalogue-grade drives (lost motion about 1.15 arcmin) logged at 401 points
     per curve: 2 % of its lost motion is 0.023 arcmin (1.4 arcsec) per reading. Cup torsion
     (expected sd of K 1 %), housing compliance (3 %) and flank friction at mu 0.1 (7 %) are
-    each named first and recovered within 15 %."""
-    _hidden_one(tmp_path, batch_specimens, dense_tables, effect, 0.02 * batch_signal, DENSE_STEPS, BATCH,
-                BATCH_VALUES)
+    each named first, with no look-alike, and recovered within 15 %."""
+    diag = _hidden_one(tmp_path, batch_specimens, dense_tables, effect, 0.02 * batch_signal, DENSE_STEPS, BATCH,
+                       BATCH_VALUES)
+    # stricter than the issue's "first or among the indistinguishable": on this batch each
+    # stands clear of the runner-up (ΔBIC gaps in seed 11: cup torsion 20 over housing compliance,
+    # housing 993, friction 165; the tie threshold is 6)
+    assert diag["verdict"]["missing_effect"] == effect and diag["verdict"]["indistinguishable_from"] == []
 
 
 def test_no_hidden_effect_no_verdict(tmp_path, specimens, tables, signal):
