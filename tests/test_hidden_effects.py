@@ -28,7 +28,7 @@ over all points (diagnosis.detectability).
   friction at mu 0.1 (expected sd 7 %). Two hidden effects (temperature, cup) are found in
   two rounds, with the first recalibrated on actual solves before the second round
   (``diagnose(..., solve=...)``, as the workflow does).
-* Flank friction changes the curves by 0.003 arcmin RMS, whatever the batch: our section's
+* Flank friction changes the curves by about 0.003 arcmin RMS on either batch: our section's
   flanks barely slide (docs/validation.md). It shows only where the noise is small in
   absolute terms, so only on the tight batch. At mu 0.08 its expected sd there is 10 %, and
   noise seed 11 misses 15 % (0.0923, 15.4 % off; 4 of 5 seeds pass). The test therefore uses
