@@ -23,12 +23,12 @@ from pathlib import Path
 
 import numpy as np
 
-from hdwf.campaign import (add_noise, design_ranges, format_ranges, mean_lost_motion, parse_range,
+from hdwf.validation.campaign import (add_noise, design_ranges, format_ranges, mean_lost_motion, parse_range,
                            plan_variants, specimen_solver, synth_curves, synth_designs)
-from hdwf.diagnosis import diagnose
-from hdwf.effects import registry
-from hdwf.io import atomic_path
-from hdwf.measurements import load_measurements
+from hdwf.validation.diagnosis import diagnose
+from hdwf.validation.effects import registry
+from hdwf.common.io import atomic_path
+from hdwf.validation.measurements import load_measurements
 
 UNIT = "hd42"
 DESIGN_SEED = 11

@@ -27,8 +27,8 @@ except ImportError:
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
 from hdwf.fe import solve_lost_motion  # noqa: E402
-from hdwf.geometry import drive_geometry  # noqa: E402
-from hdwf.mesh import build_mesh  # noqa: E402
+from hdwf.drive.geometry import drive_geometry  # noqa: E402
+from hdwf.drive.mesh import build_mesh  # noqa: E402
 
 
 DESIGNS = {

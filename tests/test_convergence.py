@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from hdwf.convergence import gci
+from hdwf.study.convergence import gci
 
 
 @pytest.mark.parametrize("order", [1.0, 2.0, 1.5])
@@ -52,7 +52,7 @@ def test_sizes_must_be_ordered():
 def test_convergence_table_two_and_three_meshes():
     import pandas as pd
 
-    from hdwf.fe_study import convergence_table
+    from hdwf.study.convergence import convergence_table
 
     exact, c = 5.0, 0.8
     rows = []

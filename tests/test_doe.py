@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from hdwf import PARAMETER_COLUMNS, PARAMETERS
-from hdwf.doe import optimal_lhs, space_filling, unit_sample
+from hdwf.study.doe import optimal_lhs, space_filling, unit_sample
 
 BOUNDS = {"d": (31.0, 31.016), "D": (41.984, 42.0), "Gr": (0.005, 0.02), "rFS": (0.0, 0.02), "rCS": (0.0, 0.02)}
 
@@ -58,7 +58,7 @@ def test_synth_designs_sample_a_batch_inside_its_range():
     """`--range` narrows the Latin hypercube of a synthetic campaign: one specimen in each of
     the n equal strata of the narrowed range (the LHS property), the other parameters on the
     paper's Table 3 ranges as before, the same seed giving the same specimens."""
-    from hdwf.campaign import synth_designs
+    from hdwf.validation.campaign import synth_designs
 
     n = 8
     batch = synth_designs("hd42", n, 3, {"rFS_mm": (0.0, 0.002), "rCS_mm": (0.001, 0.001)})

@@ -7,12 +7,12 @@ import math
 import numpy as np
 import pytest
 
-from hdwf.effects import model_changes, parse_assignment, registry
-from hdwf.effects.oldham_play import ARCSEC
-from hdwf.effects.thermal import ALPHA_STEEL
+from hdwf.validation.effects import model_changes, parse_assignment, registry
+from hdwf.validation.effects.oldham_play import ARCSEC
+from hdwf.validation.effects.thermal import ALPHA_STEEL
 from hdwf.fe import ModelChanges, solve_lost_motion
-from hdwf.geometry import drive_geometry
-from hdwf.mesh import build_mesh
+from hdwf.drive.geometry import drive_geometry
+from hdwf.drive.mesh import build_mesh
 
 ARCMIN = math.pi / (180 * 60)
 

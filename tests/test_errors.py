@@ -6,8 +6,8 @@ import pytest
 import yaml
 
 from hdwf.config import load_config
-from hdwf.errors import ConfigError, InputError
-from hdwf.paper import load_fea_designs
+from hdwf.common.errors import ConfigError, InputError
+from hdwf.study.paper import load_fea_designs
 
 from conftest import ROOT
 

@@ -18,8 +18,8 @@ except ImportError:  # package not installed: use the source tree
 
 from hdwf.fe import (ball_compliance_coeff, edge_loads, hertz_point_contact, solve_linear,
                      solve_lost_motion)
-from hdwf.geometry import ARCMIN, drive_geometry
-from hdwf.mesh import annulus_mesh, build_mesh
+from hdwf.drive.geometry import ARCMIN, drive_geometry
+from hdwf.drive.mesh import annulus_mesh, build_mesh
 
 E, NU = 210_000.0, 0.3
 COARSE = dict(elements_over_height=6, elements_over_thickness=4, refinement=1.0)
@@ -182,7 +182,7 @@ def test_hd120_phi_at_least_the_rigid_backlash():
     the elastic twist at +T (phi from the +0 state) is positive and below 2 arcmin."""
     r = _run("hd120", 90.0, 120.0, 0.030, 0.025, 0.025)
     assert r.status == "ok", r.reason
-    from hdwf.geometry import geometric_backlash_arcmin
+    from hdwf.drive.geometry import geometric_backlash_arcmin
     g = drive_geometry("hd120", 90.0, 120.0, 0.030, 0.025, 0.025)
     assert r.lost_motion_arcmin >= geometric_backlash_arcmin(g)
     assert 0.0 < r.phi_plus_arcmin < 2.0
@@ -247,7 +247,7 @@ def test_half_model_equals_full_model(args):
 def test_half_mesh_has_half_the_nodes_and_keeps_its_flag():
     """About half the nodes of the full mesh; the flag survives a DriveMesh rebuilt from
     ``bodies`` and ``sizes`` only (what fe_study stores); cut nodes pair up."""
-    from hdwf.mesh import DriveMesh
+    from hdwf.drive.mesh import DriveMesh
 
     g = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.005, 0.005)
     full = build_mesh(g, **COARSE)

@@ -13,7 +13,7 @@ try:
 except ImportError:  # package not installed: use the source tree
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-from hdwf.geometry import (ARCMIN, cam_radius, cs_half_space_angle, drive_geometry,
+from hdwf.drive.geometry import (ARCMIN, cam_radius, cs_half_space_angle, drive_geometry,
                            fs_half_angle, geometric_backlash_arcmin, nominal_geometry)
 
 
@@ -104,7 +104,7 @@ def test_zero_offset_is_zero_backlash_and_backlash_formula():
 def test_mesh_groups_and_density(tmp_path):
     """Coarse mesh: all 240 / 242 teeth present, named groups, .msh written; each flank
     carries elements_over_height segments."""
-    from hdwf.mesh import build_mesh
+    from hdwf.drive.mesh import build_mesh
     g = nominal_geometry("hd42")
     path = tmp_path / "hd42.msh"
     m = build_mesh(g, elements_over_height=4, elements_over_thickness=3, refinement=1.0,
@@ -135,7 +135,7 @@ def test_every_constant_has_a_source():
     """The one table of values stays complete: each field of UnitData has a unit and a source."""
     import dataclasses
 
-    from hdwf.geometry import _SOURCES, UnitData, assumptions_table
+    from hdwf.drive.geometry import _SOURCES, UnitData, assumptions_table
 
     assert {f.name for f in dataclasses.fields(UnitData)} == set(_SOURCES)
     assert all(row["source"] for row in assumptions_table())

@@ -42,10 +42,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from hdwf.campaign import (mean_lost_motion, plan_variants, specimen_solver, synth_designs,
+from hdwf.validation.campaign import (mean_lost_motion, plan_variants, specimen_solver, synth_designs,
                            synthesize, variant_key)
-from hdwf.diagnosis import diagnose
-from hdwf.measurements import load_measurements
+from hdwf.validation.diagnosis import diagnose
+from hdwf.validation.measurements import load_measurements
 
 UNIT = "hd42"
 N_SPECIMENS = 12
@@ -263,8 +263,8 @@ def test_plan_before_measuring_predicts_what_the_diagnosis_reports(tmp_path, spe
     """`hdwf plan` (detectability from the tables alone, before any measurement) must give the
     same table as the diagnosis of data measured on those specimens at that noise: both see
     the same points, so the same change vectors."""
-    from hdwf.campaign import candidate_names
-    from hdwf.diagnosis import detectability_of_tables
+    from hdwf.validation.campaign import candidate_names
+    from hdwf.validation.diagnosis import detectability_of_tables
 
     noise = 0.02 * signal
     plan = detectability_of_tables(tables, UNIT, noise, candidate_names({}))

@@ -4,10 +4,11 @@ import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
-from hdwf.aggregate import paper_lost_motion_stage, write_lost_motion
+from hdwf.stages.paper import paper_lost_motion_stage
+from hdwf.study.aggregate import write_lost_motion
 from hdwf.config import config_hash
-from hdwf.io import atomic_path, read_parquet_meta
-from hdwf.provenance import provenance
+from hdwf.common.io import atomic_path, read_parquet_meta
+from hdwf.common.provenance import provenance
 
 from conftest import ROOT
 

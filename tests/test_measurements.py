@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from hdwf.measurements import MeasurementError, load_measurements
+from hdwf.validation.measurements import MeasurementError, load_measurements
 
 PARAMS = {"d_mm": 31.008, "D_mm": 41.992, "Gr_mm": 0.012, "rFS_mm": 0.01, "rCS_mm": 0.01}
 TORQUES = [0.0, 0.48, 0.96, 0.48, 0.0, -0.48, -0.96, -0.48, 0.0]

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from hdwf import PARAMETER_COLUMNS, PARAMETERS
-from hdwf.paper import load_bearings, load_drives, load_fea_designs, load_published, table3_bounds
+from hdwf.study.paper import load_bearings, load_drives, load_fea_designs, load_published, table3_bounds
 
 
 @pytest.mark.parametrize("unit", ["hd42", "hd120"])

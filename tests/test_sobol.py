@@ -5,9 +5,9 @@ import pandas as pd
 import pytest
 
 from hdwf import PARAMETER_COLUMNS, PARAMETERS
-from hdwf.paper import load_fea_designs, load_published
-from hdwf.sobol import convergence, estimate_indices, exact_indices, exact_quadratic_indices, radial_matrix
-from hdwf.surrogate import fit_quadratic
+from hdwf.study.paper import load_fea_designs, load_published
+from hdwf.study.sobol import convergence, estimate_indices, exact_indices, exact_quadratic_indices, radial_matrix
+from hdwf.study.surrogate import fit_quadratic
 
 
 def test_additive_linear_function():

@@ -5,8 +5,8 @@ import pandas as pd
 import pytest
 
 from hdwf import PARAMETER_COLUMNS
-from hdwf.paper import load_fea_designs, load_published
-from hdwf.stats import CORRELATION_COLUMNS, correlation
+from hdwf.study.paper import load_fea_designs, load_published
+from hdwf.study.stats import CORRELATION_COLUMNS, correlation
 
 
 def _frame(X, y):

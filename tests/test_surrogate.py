@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from hdwf import PARAMETER_COLUMNS
-from hdwf.paper import load_fea_designs
-from hdwf.surrogate import design_matrix, fit_quadratic, rebound, term_names
+from hdwf.study.paper import load_fea_designs
+from hdwf.study.surrogate import design_matrix, fit_quadratic, rebound, term_names
 
 LO, HI = np.array([0, 10, -1, 0, 5.0]), np.array([1, 20, 1, 2, 6.0])
 

@@ -1,10 +1,10 @@
-"""Comparison statistics and the verdict logic of hdwf.validation."""
+"""Comparison statistics and the verdict logic of hdwf.validation.comparison."""
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from hdwf.validation import Candidate, bic, branches, comparison_points, residual_tests, summarise, verdict
+from hdwf.validation.comparison import Candidate, bic, branches, comparison_points, residual_tests, summarise, verdict
 
 TORQUES = [0.0, 0.48, 0.96, 0.48, 0.0, -0.48, -0.96, -0.48, 0.0]
 
@@ -73,7 +73,7 @@ def test_verdict_names_the_effect_ties_and_none():
 
 def _linear_response(g):
     """Flank friction's response made exactly linear in mu: the change at mu is mu * g."""
-    from hdwf.diagnosis import Response
+    from hdwf.validation.diagnosis import Response
 
     t = np.array([0.0, 0.1, 0.2, 0.3])
     return Response("tooth_friction", "mu", t, t[:, None] * g[None, :], (0.0, 0.3))
@@ -82,8 +82,8 @@ def _linear_response(g):
 def test_detectability_of_a_linear_effect():
     """Change at the realistic mu = 0.08 is 0.08 g; the parameter's relative sd is sigma/|change|
     (linear least squares); at the stated 'noise to show' the effect earns exactly the pay
-    threshold, ΔBIC = -10, by the BIC of hdwf.validation."""
-    from hdwf.diagnosis import detectability
+    threshold, ΔBIC = -10, by the BIC of hdwf.validation.comparison."""
+    from hdwf.validation.diagnosis import detectability
 
     rng = np.random.default_rng(3)
     g = rng.normal(0.0, 1.0, 200)
@@ -106,8 +106,8 @@ def test_report_says_which_effects_the_data_could_not_show():
     """The report's table and sentence come from diagnosis.json: a candidate the data could not
     show is named with the noise it needs; a perfect fit (noise 0: sd null in the JSON) prints
     a dash, not an error; a found effect is not listed as unseen."""
-    from hdwf.diagnosis import detectability, json_safe
-    from hdwf.report import Document, _detectability_part
+    from hdwf.validation.diagnosis import detectability, json_safe
+    from hdwf.report.document import Document, _detectability_part
 
     g = np.linspace(-1.0, 1.0, 100)
     resp = {"tooth_friction": _linear_response(g)}
@@ -135,7 +135,7 @@ def _kinked_thermal(n_points=60, seed=5):
     one): twist_i(dT) = base_i - g_i max(dT - k_i, 0), g_i > 0 (the dead band shrinks), kinks
     k_i in 11..14 or 20..23 K (straight in between); and a ``solve`` that returns it exactly for
     any variant, counting its calls."""
-    from hdwf.campaign import plan_variants, variant_key
+    from hdwf.validation.campaign import plan_variants, variant_key
 
     rng = np.random.default_rng(seed)
     g = rng.uniform(0.01, 0.03, n_points)
@@ -166,7 +166,7 @@ def test_anchoring_on_actual_solves_removes_the_tables_interpolation_error():
     around its estimate (three, in one call), the response is exact there (straight between
     the kinks, so the quadratic through the three is exact) and the calibration recovers
     17 K; the log says where it solved."""
-    from hdwf.diagnosis import calibrate, refine_fit, responses
+    from hdwf.validation.diagnosis import calibrate, refine_fit, responses
 
     table, obs, twist, solve, calls = _kinked_thermal()
     resp = responses(table, obs, {}, ["thermal"])
@@ -190,7 +190,7 @@ def test_an_anchored_response_is_exact_at_the_grid_and_off_at_zero():
     the solves, the shift fading to zero at the next grid value: it stays continuous at the
     interval's ends and equals the table (an actual solve) at every grid value, so t = 0
     still means "off"."""
-    from hdwf.diagnosis import anchored_responses, responses
+    from hdwf.validation.diagnosis import anchored_responses, responses
 
     table, obs, twist, solve, _ = _kinked_thermal()
     resp = responses(table, obs, {}, ["thermal"])["thermal"]
@@ -207,7 +207,7 @@ def test_an_anchored_response_is_exact_at_the_grid_and_off_at_zero():
 def test_a_failed_anchor_solve_keeps_the_table_and_says_so():
     """A solve that raises, or returns a failed status, must not lose the diagnosis: the
     table's response is kept, the estimate is the table's, and the log names the failure."""
-    from hdwf.diagnosis import calibrate, refine_fit, responses
+    from hdwf.validation.diagnosis import calibrate, refine_fit, responses
 
     table, obs, twist, solve, _ = _kinked_thermal()
     S0, D = twist({}), twist({"thermal": {"delta_T_K": 17.0}})
@@ -234,8 +234,8 @@ def test_anchor_points_of_a_stiffness_stay_inside_its_values():
     """Housing stiffness is tabulated in t = k^-3/4, where t = 0 ("off", k infinite) is not
     a value: an estimate at or near 0 is solved at three finite stiffnesses within the
     parameter's bounds, in increasing t, a tenth of the grid spacing apart."""
-    from hdwf.diagnosis import Response, anchor_points
-    from hdwf.effects import get
+    from hdwf.validation.diagnosis import Response, anchor_points
+    from hdwf.validation.effects import get
 
     p = get("cs_housing").param("k_N_per_mm2")
     lo, hi = p.t_bounds
@@ -250,7 +250,7 @@ def test_anchor_points_of_a_stiffness_stay_inside_its_values():
 def test_report_says_where_an_effect_was_re_solved():
     """diagnosis.json's ``refinement`` in words: the values solved at, and a caution when a
     solve failed (the sentence must not claim a recalibration that did not happen)."""
-    from hdwf.report import Document, _refinement_part
+    from hdwf.report.document import Document, _refinement_part
 
     diag = {"refinement": {
         "thermal": {"status": "anchored", "before_round": 2, "param": "delta_T_K",

@@ -7,9 +7,9 @@ import pytest
 import yaml
 
 from hdwf.config import validate_config
-from hdwf.errors import ConfigError
-from hdwf.measurements import load_measurements
-from hdwf.paper import load_fea_designs, paper_measurements
+from hdwf.common.errors import ConfigError
+from hdwf.validation.measurements import load_measurements
+from hdwf.study.paper import load_fea_designs, paper_measurements
 
 from conftest import DATA, ROOT
 

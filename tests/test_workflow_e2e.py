@@ -8,7 +8,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from hdwf.io import read_json, read_parquet_meta
+from hdwf.common.io import read_json, read_parquet_meta
 
 from conftest import ROOT
 

@@ -7,11 +7,11 @@ import json
 import sys
 from pathlib import Path
 
-from .errors import InputError
+from hdwf.common.errors import InputError
 
 
 def _check_config(args) -> int:
-    from .config import config_hash, load_config
+    from hdwf.config import config_hash, load_config
 
     config = load_config(args.config, args.schema)
     print(f"{args.config}: valid; config hash {config_hash(config)}")
@@ -19,8 +19,8 @@ def _check_config(args) -> int:
 
 
 def _provenance(args) -> int:
-    from .config import load_config
-    from .provenance import provenance
+    from hdwf.config import load_config
+    from hdwf.common.provenance import provenance
 
     config = load_config(args.config, args.schema)
     print(json.dumps(provenance(config, Path(args.config).resolve().parent), indent=2))
@@ -52,7 +52,7 @@ def _specimen_options(p, seed_help: str, noise_help: str) -> None:
 
 def _design_ranges(args) -> dict[str, tuple[float, float]]:
     """The --range options as {column: (low, high)}, checked against the model's support."""
-    from .campaign import design_ranges, parse_range
+    from hdwf.validation.campaign import design_ranges, parse_range
 
     ranges = {}
     for text in args.range:
@@ -76,9 +76,9 @@ def _solve_options(p, elements_over_height: int, elements_over_thickness: int) -
 
 
 def _synth(args) -> int:
-    from .campaign import format_ranges, synthesize
-    from .effects import parse_assignment
-    from .io import atomic_path
+    from hdwf.validation.campaign import format_ranges, synthesize
+    from hdwf.validation.effects import parse_assignment
+    from hdwf.common.io import atomic_path
 
     out = Path(args.out)
     if out.suffix.lower() not in (".csv", ".parquet"):
@@ -110,7 +110,7 @@ def _synth(args) -> int:
 
 
 def _effects(args) -> int:
-    from .effects import registry
+    from hdwf.validation.effects import registry
 
     for eff in registry().values():
         print(f"{eff.name}: {eff.title}{' (in series at the output)' if eff.series else ''}")
@@ -122,9 +122,9 @@ def _effects(args) -> int:
 
 
 def _plan(args) -> int:
-    from .campaign import format_ranges, synth_designs
-    from .diagnosis import json_safe, plan_detectability
-    from .io import atomic_path
+    from hdwf.validation.campaign import format_ranges, synth_designs
+    from hdwf.validation.diagnosis import json_safe, plan_detectability
+    from hdwf.common.io import atomic_path
 
     out = Path(args.out) if args.out else None
     if out is not None:
@@ -155,8 +155,8 @@ def _plan(args) -> int:
 
 
 def _paper_measurements(args) -> int:
-    from .io import atomic_path
-    from .paper import paper_measurements
+    from hdwf.common.io import atomic_path
+    from hdwf.study.paper import paper_measurements
 
     out = Path(args.out)
     _refuse_existing(out, args, "measurement files are never overwritten: ")

@@ -13,7 +13,7 @@ from pathlib import Path
 import jsonschema
 import yaml
 
-from .errors import ConfigError
+from hdwf.common.errors import ConfigError
 
 
 def _key_path(error: jsonschema.ValidationError) -> str:
@@ -81,7 +81,7 @@ def _check_relations(config: dict, source) -> None:
 
 def _check_campaign(name: str, camp: dict, source) -> None:
     """Effect names, parameters and values of a campaign against the effects registry."""
-    from .effects import registry
+    from hdwf.validation.effects import registry
 
     known = registry()
     where = f"validation.{name}"

@@ -1,5 +1,7 @@
 # Shared helpers: which studies, drives and designs exist; where the repository is (provenance).
 
+from hdwf.study.paper import FEA_TABLES
+
 REPO_DIR = workflow.basedir
 STUDIES = config["studies"]
 PAPER_STUDIES = [s for s, v in STUDIES.items() if v["source"] == "paper"]

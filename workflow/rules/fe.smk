@@ -3,7 +3,7 @@
 
 def _fe_design_source(w):
     if STUDIES[w.study]["designs"] == "paper":
-        return f"{config['paper_data']}/" + {"hd42": "table4_hd42_fea.csv", "hd120": "table5_hd120_fea.csv"}[w.unit]
+        return f"{config['paper_data']}/{FEA_TABLES[w.unit]}"
     return f"results/doe/{w.unit}/designs.parquet"
 
 

@@ -2,7 +2,7 @@
 
 rule paper_lost_motion:
     input:
-        table=lambda w: f"{config['paper_data']}/" + {"hd42": "table4_hd42_fea.csv", "hd120": "table5_hd120_fea.csv"}[w.unit],
+        table=lambda w: f"{config['paper_data']}/{FEA_TABLES[w.unit]}",
     output:
         "results/{study}/{unit}/lost_motion.parquet",
     wildcard_constraints:

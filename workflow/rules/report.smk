@@ -1,6 +1,6 @@
 # The study's PDF report, typeset with typst from the artefacts only.
 
-# Per-drive artefacts the report reads, keyed as hdwf.report expects them ("<unit>__<key>").
+# Per-drive artefacts the report reads, keyed as hdwf.report.document expects them ("<unit>__<key>").
 REPORT_ARTEFACTS = {
     "lost_motion": "lost_motion.parquet",
     "correlation": "correlation.parquet",

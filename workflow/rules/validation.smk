@@ -6,9 +6,9 @@
 import dataclasses
 import re
 
-from hdwf.campaign import campaign_plan
-from hdwf.errors import InputError
-from hdwf.measurements import load_measurements
+from hdwf.validation.campaign import campaign_plan
+from hdwf.common.errors import InputError
+from hdwf.validation.measurements import load_measurements
 
 CAMPAIGNS = {name: campaign_plan(name, c, FE) for name, c in config.get("validation", {}).items()}
 _SPECIMENS = {}

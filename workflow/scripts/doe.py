@@ -1,14 +1,17 @@
-"""Adapter for rule doe: Table 3 bounds -> optimal LHS (hdwf.doe.doe_stage)."""
-import logging, sys
-sys.path.insert(0, __import__("os").path.dirname(__file__))
-from _adapter import setup  # noqa: E402
+"""Rule doe: Table 3 bounds -> optimal LHS (hdwf.study.doe.doe_stage)."""
+import logging
 
-from hdwf.doe import doe_stage  # noqa: E402
-from hdwf.paper import table3_bounds  # noqa: E402
+from _helpers import mock_snakemake, setup
 
-prov = setup(snakemake)  # noqa: F821
-unit = snakemake.wildcards.unit  # noqa: F821
-bounds = table3_bounds(snakemake.config["paper_data"], unit)  # noqa: F821
-df = doe_stage(bounds, snakemake.params.n, snakemake.params.seed, snakemake.params.optimization,  # noqa: F821
-               snakemake.output[0], prov, unit)  # noqa: F821
+from hdwf.stages.doe import doe_stage
+from hdwf.study.paper import table3_bounds
+
+if "snakemake" not in globals():  # run outside Snakemake, from the project root
+    snakemake = mock_snakemake("doe", unit="hd42")
+
+prov = setup(snakemake)
+unit = snakemake.wildcards.unit
+bounds = table3_bounds(snakemake.config["paper_data"], unit)
+df = doe_stage(bounds, snakemake.params.n, snakemake.params.seed, snakemake.params.optimization,
+               snakemake.output[0], prov, unit)
 logging.info("wrote %d designs for %s", len(df), unit)

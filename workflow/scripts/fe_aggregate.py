@@ -1,12 +1,15 @@
-"""Adapter for rule fe_aggregate: per-design rows and curves -> lost_motion.parquet, curves.parquet."""
-import logging, sys
-sys.path.insert(0, __import__("os").path.dirname(__file__))
-from _adapter import setup  # noqa: E402
+"""Rule fe_aggregate: per-design rows and curves -> lost_motion.parquet, curves.parquet."""
+import logging
 
-from hdwf.fe_study import aggregate_stage  # noqa: E402
+from _helpers import mock_snakemake, setup
 
-prov = setup(snakemake)  # noqa: F821
-w = snakemake.wildcards  # noqa: F821
-rows = aggregate_stage(snakemake.input.rows, snakemake.input.curves, snakemake.output.lost_motion,  # noqa: F821
-                       snakemake.output.curves, prov, {"study": w.study, "unit": w.unit, "source": "hdwf FE"})  # noqa: F821
+from hdwf.stages.fe import aggregate_stage
+
+if "snakemake" not in globals():  # run outside Snakemake, from the project root
+    snakemake = mock_snakemake("fe_aggregate", study="fe", unit="hd42")
+
+prov = setup(snakemake)
+w = snakemake.wildcards
+rows = aggregate_stage(snakemake.input.rows, snakemake.input.curves, snakemake.output.lost_motion,
+                       snakemake.output.curves, prov, {"study": w.study, "unit": w.unit, "source": "hdwf FE"})
 logging.info("%d designs, %d ok", len(rows), int((rows["status"] == "ok").sum()))

@@ -1,12 +1,15 @@
-"""Adapter for rule fe_convergence: Φ at three refinements -> convergence.parquet with the GCI."""
-import logging, sys
-sys.path.insert(0, __import__("os").path.dirname(__file__))
-from _adapter import setup  # noqa: E402
+"""Rule fe_convergence: Φ at three refinements -> convergence.parquet with the GCI."""
+import logging
 
-from hdwf.fe_study import convergence_stage  # noqa: E402
+from _helpers import mock_snakemake, setup
 
-prov = setup(snakemake)  # noqa: F821
-w = snakemake.wildcards  # noqa: F821
-table = convergence_stage(snakemake.input.default, snakemake.input.other_meshes, snakemake.params.refinement,  # noqa: F821
-                          snakemake.output[0], prov, {"study": w.study, "unit": w.unit})  # noqa: F821
+from hdwf.stages.fe import convergence_stage
+
+if "snakemake" not in globals():  # run outside Snakemake, from the project root
+    snakemake = mock_snakemake("fe_convergence", study="fe", unit="hd42")
+
+prov = setup(snakemake)
+w = snakemake.wildcards
+table = convergence_stage(snakemake.input.default, snakemake.input.other_meshes, snakemake.params.refinement,
+                          snakemake.output[0], prov, {"study": w.study, "unit": w.unit})
 logging.info("\n%s", table.to_string())

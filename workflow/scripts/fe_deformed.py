@@ -1,12 +1,15 @@
-"""Adapter for rule fe_deformed: one design with its displacement fields -> picture + fields."""
-import logging, sys
-sys.path.insert(0, __import__("os").path.dirname(__file__))
-from _adapter import setup  # noqa: E402
+"""Rule fe_deformed: one design with its displacement fields -> picture + fields."""
+import logging
 
-from hdwf.fe_study import deformed_stage  # noqa: E402
+from _helpers import mock_snakemake, setup
 
-prov = setup(snakemake)  # noqa: F821
-w = snakemake.wildcards  # noqa: F821
-facts = deformed_stage(snakemake.input[0], w.design, w.unit, dict(snakemake.params.settings),  # noqa: F821
-                       snakemake.params.steps_per_ramp, snakemake.output.png, snakemake.output.fields, prov)  # noqa: F821
+from hdwf.stages.fe import deformed_stage
+
+if "snakemake" not in globals():  # run outside Snakemake, from the project root
+    snakemake = mock_snakemake("fe_deformed", study="fe", unit="hd42", design="hd42-lhs-01")
+
+prov = setup(snakemake)
+w = snakemake.wildcards
+facts = deformed_stage(snakemake.input[0], w.design, w.unit, dict(snakemake.params.settings),
+                       snakemake.params.steps_per_ramp, snakemake.output.png, snakemake.output.fields, prov)
 logging.info("%s", facts)

@@ -1,12 +1,15 @@
-"""Adapter for rule fe_mesh: one design -> gmsh .msh (review) and .npz (solver input)."""
-import logging, sys
-sys.path.insert(0, __import__("os").path.dirname(__file__))
-from _adapter import setup  # noqa: E402
+"""Rule fe_mesh: one design -> gmsh .msh (review) and .npz (solver input)."""
+import logging
 
-from hdwf.fe_study import mesh_stage  # noqa: E402
+from _helpers import mock_snakemake, setup
 
-setup(snakemake)  # noqa: F821
-w = snakemake.wildcards  # noqa: F821
-facts = mesh_stage(snakemake.input[0], w.design, w.unit, dict(snakemake.params.settings),  # noqa: F821
-                   snakemake.output.msh, snakemake.output.npz)  # noqa: F821
+from hdwf.stages.fe import mesh_stage
+
+if "snakemake" not in globals():  # run outside Snakemake, from the project root
+    snakemake = mock_snakemake("fe_mesh", study="fe", unit="hd42", design="hd42-lhs-01")
+
+setup(snakemake)
+w = snakemake.wildcards
+facts = mesh_stage(snakemake.input[0], w.design, w.unit, dict(snakemake.params.settings),
+                   snakemake.output.msh, snakemake.output.npz)
 logging.info("%s", facts)

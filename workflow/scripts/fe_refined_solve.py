@@ -1,12 +1,15 @@
-"""Adapter for rule fe_refined_solve: one design at another mesh refinement -> one row."""
-import logging, sys
-sys.path.insert(0, __import__("os").path.dirname(__file__))
-from _adapter import setup  # noqa: E402
+"""Rule fe_refined_solve: one design at another mesh refinement -> one row."""
+import logging
 
-from hdwf.fe_study import refined_solve_stage  # noqa: E402
+from _helpers import mock_snakemake, setup
 
-prov = setup(snakemake)  # noqa: F821
-w = snakemake.wildcards  # noqa: F821
-row = refined_solve_stage(snakemake.input[0], w.design, w.unit, dict(snakemake.params.settings),  # noqa: F821
-                          snakemake.params.steps_per_ramp, snakemake.output[0], prov)  # noqa: F821
+from hdwf.stages.fe import refined_solve_stage
+
+if "snakemake" not in globals():  # run outside Snakemake, from the project root
+    snakemake = mock_snakemake("fe_refined_solve", study="fe", unit="hd42", design="hd42-lhs-01", ref="1.25")
+
+prov = setup(snakemake)
+w = snakemake.wildcards
+row = refined_solve_stage(snakemake.input[0], w.design, w.unit, dict(snakemake.params.settings),
+                          snakemake.params.steps_per_ramp, snakemake.output[0], prov)
 logging.info("%s", row)

@@ -1,12 +1,15 @@
-"""Adapter for rule fe_solve: one design's mesh -> its lost-motion row and torque–twist curve."""
-import logging, sys
-sys.path.insert(0, __import__("os").path.dirname(__file__))
-from _adapter import setup  # noqa: E402
+"""Rule fe_solve: one design's mesh -> its lost-motion row and torque–twist curve."""
+import logging
 
-from hdwf.fe_study import solve_stage  # noqa: E402
+from _helpers import mock_snakemake, setup
 
-prov = setup(snakemake)  # noqa: F821
-w = snakemake.wildcards  # noqa: F821
-row = solve_stage(snakemake.input.designs, w.design, w.unit, snakemake.input.mesh,  # noqa: F821
-                  snakemake.params.steps_per_ramp, snakemake.output.row, snakemake.output.curve, prov)  # noqa: F821
+from hdwf.stages.fe import solve_stage
+
+if "snakemake" not in globals():  # run outside Snakemake, from the project root
+    snakemake = mock_snakemake("fe_solve", study="fe", unit="hd42", design="hd42-lhs-01")
+
+prov = setup(snakemake)
+w = snakemake.wildcards
+row = solve_stage(snakemake.input.designs, w.design, w.unit, snakemake.input.mesh,
+                  snakemake.params.steps_per_ramp, snakemake.output.row, snakemake.output.curve, prov)
 logging.info("%s", row)

@@ -1,9 +1,9 @@
-"""Adapter for rule study_report: the study's artefacts -> report.pdf (hdwf.report)."""
+"""Adapter for rule study_report: the study's artefacts -> report.pdf (hdwf.report.document)."""
 import sys
 sys.path.insert(0, __import__("os").path.dirname(__file__))
 from _adapter import setup  # noqa: E402
 
-from hdwf.report import study_report  # noqa: E402
+from hdwf.report.document import study_report  # noqa: E402
 
 prov = setup(snakemake)  # noqa: F821
 study_report(study=snakemake.wildcards.study, units=snakemake.params.units,  # noqa: F821

@@ -3,8 +3,8 @@ import logging, sys
 sys.path.insert(0, __import__("os").path.dirname(__file__))
 from _adapter import setup  # noqa: E402
 
-from hdwf.campaign import CampaignPlan  # noqa: E402
-from hdwf.diagnosis import diagnosis_stage  # noqa: E402
+from hdwf.validation.campaign import CampaignPlan  # noqa: E402
+from hdwf.validation.diagnosis import diagnosis_stage  # noqa: E402
 
 # guarded: the re-solves before a further round run in spawned processes, which import this file
 if __name__ == "__main__":

@@ -5,7 +5,7 @@ from _adapter import setup  # noqa: E402
 
 import pandas as pd  # noqa: E402
 
-from hdwf.plots import ladder_figure, measured_vs_predicted_figure, residual_figure  # noqa: E402
+from hdwf.report.figures import ladder_figure, measured_vs_predicted_figure, residual_figure  # noqa: E402
 
 setup(snakemake)  # noqa: F821
 inp, out = snakemake.input, snakemake.output  # noqa: F821

@@ -4,7 +4,7 @@ import logging, sys
 sys.path.insert(0, __import__("os").path.dirname(__file__))
 from _adapter import setup  # noqa: E402
 
-from hdwf.diagnosis import ladder_stage  # noqa: E402
+from hdwf.validation.diagnosis import ladder_stage  # noqa: E402
 
 # guarded: the solves run in spawned processes, which import this file
 if __name__ == "__main__":

@@ -3,7 +3,7 @@ import logging, sys
 sys.path.insert(0, __import__("os").path.dirname(__file__))
 from _adapter import setup  # noqa: E402
 
-from hdwf.campaign import specimen_stage  # noqa: E402
+from hdwf.validation.campaign import specimen_stage  # noqa: E402
 
 prov = setup(snakemake)  # noqa: F821
 p = snakemake.params  # noqa: F821

@@ -1,7 +1,7 @@
 """Sobol' sensitivity indices of the surrogate: estimated (SALib) and exact.
 
 Estimates follow SALib's sample/analyze split: the base sample (LHS, Halton or Sobol',
-from ``hdwf.doe``) of dimension 2k gives the matrices A and B, the radial matrices AB_i
+from ``hdwf.study.doe``) of dimension 2k gives the matrices A and B, the radial matrices AB_i
 are built in SALib's row order (A, AB_1..AB_k, B per base point) and
 ``SALib.analyze.sobol.analyze`` returns S1 and ST (Saltelli 2010 / Jansen estimators) with
 bootstrap confidence intervals.  The exact indices of a quadratic come from its Legendre
@@ -16,8 +16,8 @@ import numpy as np
 import pandas as pd
 from SALib.analyze import sobol as salib_sobol
 
-from .doe import unit_sample
-from .surrogate import QuadraticSurrogate
+from hdwf.study.doe import unit_sample
+from hdwf.study.surrogate import QuadraticSurrogate
 
 SOBOL_COLUMNS = ["parameter", "sampler", "n", "S1", "S1_conf", "ST", "ST_conf"]
 
@@ -122,33 +122,3 @@ def convergence(model_unit, parameters: list[str], sampler: str, *, n_start: int
     frames[-1] = full
     status["max_conf"] = float(full[["S1_conf", "ST_conf"]].to_numpy().max())
     return pd.concat(frames, ignore_index=True), status
-
-
-def sobol_stage(surrogate_json, out_parquet, out_png, samplers, settings: dict, title: str,
-                provenance: dict, other_bounds: dict[str, tuple[list, list]] | None = None) -> pd.DataFrame:
-    """Exact indices plus the convergence runs of each sampler; stopping status in the metadata.
-
-    ``other_bounds`` (name -> (lower, upper)) adds the exact indices of the same polynomial
-    over other input bounds to the metadata, to show how much the indices depend on them.
-    """
-    from .io import read_json, write_parquet
-    from .plots import sobol_convergence_figure
-
-    model = QuadraticSurrogate.from_dict(read_json(surrogate_json))
-    frames, status = [exact_indices(model)], {}
-    for sampler in samplers:
-        est, st = convergence(model.predict_unit, model.parameters, sampler, **settings)
-        frames.append(est)
-        status[sampler] = st
-    table = pd.concat(frames, ignore_index=True)
-    from .surrogate import rebound
-    other = {}
-    for name, (lower, upper) in (other_bounds or {}).items():
-        ex = exact_indices(rebound(model, lower, upper, name))
-        other[name] = {"lower": list(lower), "upper": list(upper), "S1": dict(zip(ex.parameter, ex.S1)),
-                       "ST": dict(zip(ex.parameter, ex.ST))}
-    write_parquet(table, out_parquet, provenance=provenance,
-                  meta={"convergence": status, "exact_other_bounds": other, "settings": settings, "bounds_source": model.bounds_source,
-                        "lower": model.lower, "upper": model.upper})
-    sobol_convergence_figure(table, title, out_png)
-    return table

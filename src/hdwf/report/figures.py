@@ -12,8 +12,8 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 from scipy.optimize import isotonic_regression  # noqa: E402
 
-from . import PARAMETER_COLUMNS, PARAMETER_LABELS, PARAMETERS  # noqa: E402
-from .io import atomic_path  # noqa: E402
+from hdwf import PARAMETER_COLUMNS, PARAMETER_LABELS, PARAMETERS  # noqa: E402
+from hdwf.common.io import atomic_path  # noqa: E402
 
 _PNG_META = {"Software": None}  # no version string in the file: same data, same bytes
 

@@ -12,6 +12,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+import pandas as pd
 from scipy.optimize import brentq
 
 
@@ -68,3 +70,32 @@ def gci(h: tuple[float, float, float], phi: tuple[float, float, float], safety: 
                          "GCI with safety factor 3 and first order")
     ext = (r21 ** root * f1 - f2) / (r21 ** root - 1.0)
     return GCIResult(root, ext, rel, safety * rel / (r21 ** root - 1.0), True, True, "")
+
+
+def convergence_table(results: pd.DataFrame) -> pd.DataFrame:
+    """One row per design: Φ on the fine, medium and coarse mesh, the GCI and the fine change.
+
+    ``results`` has columns design_id, refinement, h_mm (representative element size),
+    lost_motion_arcmin.
+    """
+    out = []
+    levels = ("fine", "medium", "coarse")
+    for design_id, sub in results.groupby("design_id", sort=True):
+        sub = sub.sort_values("h_mm")  # fine first
+        row = {"design_id": design_id}
+        for k, r in zip(levels, sub.itertuples()):
+            row.update({f"refinement_{k}": float(r.refinement), f"h_{k}_mm": float(r.h_mm),
+                        f"phi_{k}_arcmin": float(r.lost_motion_arcmin)})
+        phi = sub["lost_motion_arcmin"].to_numpy(float)
+        if len(sub) < 2 or not np.isfinite(phi).all():
+            row.update({"converged": False, "note": "a refinement failed or is missing"})
+        else:
+            row["rel_change_fine"] = float(abs(phi[1] - phi[0]) / abs(phi[0]))
+            row["converged"] = bool(row["rel_change_fine"] < 0.02)
+            row["note"] = ""
+            if len(sub) == 3:
+                g = gci(tuple(sub["h_mm"]), tuple(phi))
+                row.update({"gci_fine": g.gci_fine, "order_p": g.p, "phi_extrapolated_arcmin": g.phi_extrapolated,
+                            "monotone": g.monotone, "asymptotic": g.asymptotic, "note": g.note})
+        out.append(row)
+    return pd.DataFrame(out)

@@ -17,7 +17,7 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-PROVENANCE_KEY = b"hdwf.provenance"
+PROVENANCE_KEY = b"hdwf.common.provenance"
 EXTRA_KEY = b"hdwf.meta"
 
 
@@ -105,7 +105,7 @@ def read_table(path: str | Path, required: dict[str, str]) -> pd.DataFrame:
     Raises InputError naming the file, the 1-based data row and the column of the first
     bad value; a missing column is named with the columns that were found.
     """
-    from .errors import InputError
+    from hdwf.common.errors import InputError
     import numpy as np
 
     path = Path(path)

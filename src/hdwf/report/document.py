@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from . import PARAMETER_COLUMNS, PARAMETER_LABELS, PARAMETERS
-from .io import atomic_path, read_json, read_parquet_meta
-from .paper import load_bearings, load_bounds, load_drives, load_published
+from hdwf import PARAMETER_COLUMNS, PARAMETER_LABELS, PARAMETERS
+from hdwf.common.io import atomic_path, read_json, read_parquet_meta
+from hdwf.study.paper import load_bearings, load_bounds, load_drives, load_published
 
 UNIT_NAMES = {"hd42": "HD 42", "hd120": "HD 120"}
 
@@ -78,7 +78,7 @@ class Document:
     def compile(self, out) -> Path:
         import typst
 
-        template = resources.files("hdwf").joinpath("templates/report.typ").read_text()
+        template = resources.files("hdwf.report").joinpath("templates/report.typ").read_text()
         with tempfile.TemporaryDirectory(prefix="hdwf-report-") as build:
             build = Path(build)
             for i, src in enumerate(self._figures):
@@ -118,7 +118,7 @@ def _inputs_section(doc: Document, units, data_dir, study_config, level: int = 1
 
 
 def _designs_section(doc: Document, units, files, level: int = 1):
-    from .doe import space_filling, to_unit
+    from hdwf.study.doe import space_filling, to_unit
 
     doc.heading("Designs", level)
     doc.text("The paper's 27 design points per drive (Tables 4 and 5) with its Ansys FEA lost motion. Beside them, "
@@ -332,7 +332,7 @@ def _fe_model_section(doc: Document, assumptions: list[dict] | None, pictures: d
     if assumptions:
         rows = [[lit(a["unit"]), lit(a["name"]), lit(a["value"]), lit(a["source"])] for a in assumptions]
         doc.table(["drive", "quantity", "value", "source or reason"], rows,
-                  "Every value the paper does not give, with its source (`hdwf.geometry`).")
+                  "Every value the paper does not give, with its source (`hdwf.drive.geometry`).")
     for label, path in (pictures or {}).items():
         doc.figure(path, f"{label}: the FS (left) and CS (right) teeth at the major axis at +4 % $T_N$, true scale; "
                    "colour: deformation added by the test torque with each body's rotation removed. The white "
@@ -367,7 +367,7 @@ def _convergence_section(doc: Document, units, files, level: int = 1):
 
 
 def _curves_section(doc: Document, units, files, tmp: Path, level: int = 1):
-    from .plots import curves_figure
+    from hdwf.report.figures import curves_figure
 
     doc.heading("Torque–twist curves", level)
     for u in units:
@@ -395,7 +395,7 @@ def _curves_section(doc: Document, units, files, tmp: Path, level: int = 1):
 def _agreement_section(doc: Document, units, paper_files, ours_files, tmp: Path, level: int = 1):
     from scipy import stats as st
 
-    from .plots import agreement_figure
+    from hdwf.report.figures import agreement_figure
 
     doc.heading("Our FE against the paper's FEA at its own design points", level)
     rows, pairs = [], {}
@@ -453,7 +453,7 @@ def _indices_vs_paper_section(doc: Document, units, data_dir, studies_files: dic
 
 
 def _effect_sentence(r: dict) -> str:
-    from .effects import get as get_effect
+    from hdwf.validation.effects import get as get_effect
 
     eff = get_effect(r["effect"])
     (pname, val), = r["params"].items()
@@ -468,7 +468,7 @@ def _detectability_part(doc: Document, diag: dict, level: int):
     det = diag.get("detectability")
     if not det:
         return
-    from .effects import get as get_effect
+    from hdwf.validation.effects import get as get_effect
 
     doc.heading("What this data could show", level)
     rows = []

@@ -22,7 +22,7 @@ import pkgutil
 from dataclasses import dataclass, field
 from typing import Callable
 
-from ..fe import ModelChanges
+from hdwf.fe import ModelChanges
 
 
 @dataclass(frozen=True)
@@ -111,7 +111,7 @@ def registry() -> dict[str, Effect]:
         mod = importlib.import_module(f"{__name__}.{info.name}")
         eff = getattr(mod, "EFFECT", None)
         if not isinstance(eff, Effect):
-            raise TypeError(f"hdwf.effects.{info.name} defines no EFFECT = Effect(...)")
+            raise TypeError(f"hdwf.validation.effects.{info.name} defines no EFFECT = Effect(...)")
         if eff.name in out:
             raise ValueError(f"two effects are named {eff.name!r}")
         out[eff.name] = eff

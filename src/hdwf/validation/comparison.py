@@ -15,7 +15,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import pandas as pd
 
-from . import PARAMETER_COLUMNS
+from hdwf import PARAMETER_COLUMNS
 
 BRANCHES = ("load+", "unload+", "load-", "unload-")
 

@@ -7,9 +7,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from . import PARAMETER_COLUMNS, PARAMETERS
-from .errors import InputError
-from .io import read_table
+from hdwf import PARAMETER_COLUMNS, PARAMETERS
+from hdwf.common.errors import InputError
+from hdwf.common.io import read_table
 
 FEA_TABLES = {"hd42": "table4_hd42_fea.csv", "hd120": "table5_hd120_fea.csv"}
 _FEA_COLUMNS = {"set": "int", **{c: "float" for c in PARAMETER_COLUMNS}, "lost_motion_arcmin": "float"}

@@ -10,7 +10,7 @@ import pandas as pd
 import statsmodels.api as sm
 from scipy import stats
 
-from . import PARAMETER_COLUMNS, PARAMETERS
+from hdwf import PARAMETER_COLUMNS, PARAMETERS
 
 CORRELATION_COLUMNS = ["parameter", "pearson_r", "pearson_p", "spearman_rho", "spearman_p",
                        "ols_coef", "ols_std_coef", "ols_p"]
@@ -55,17 +55,3 @@ def correlation(designs: pd.DataFrame, response: str = "lost_motion_arcmin") -> 
     summary = RegressionSummary(r2=float(fit.rsquared), r2_adj=float(fit.rsquared_adj),
                                 f_pvalue=float(fit.f_pvalue), intercept=float(fit.params[0]), n=len(y))
     return pd.DataFrame(rows, columns=CORRELATION_COLUMNS), summary
-
-
-def correlation_stage(lost_motion_path, out_parquet, out_png, title: str, provenance: dict) -> pd.DataFrame:
-    """Correlation table (Parquet, regression summary in its metadata) and its figure."""
-    from dataclasses import asdict
-
-    from .io import write_parquet
-    from .plots import correlation_figure
-
-    designs = pd.read_parquet(lost_motion_path)
-    table, summary = correlation(designs)
-    write_parquet(table, out_parquet, provenance=provenance, meta={"ols": asdict(summary)})
-    correlation_figure(designs, table, title, out_png)
-    return table

@@ -14,7 +14,7 @@ import pandas as pd
 from scipy.spatial.distance import pdist
 from scipy.stats import qmc
 
-from . import PARAMETER_COLUMNS, PARAMETERS
+from hdwf import PARAMETER_COLUMNS, PARAMETERS
 
 SAMPLERS = ("lhs", "halton", "sobol")
 
@@ -81,17 +81,3 @@ def optimal_lhs(bounds: dict[str, tuple[float, float]], n: int = 27, seed: int =
     df = pd.DataFrame(values, columns=list(PARAMETER_COLUMNS))
     df.insert(0, "design_id", [f"{prefix}-{i + 1:02d}" for i in range(n)])
     return df, space_filling(unit)
-
-
-def doe_stage(bounds: dict[str, tuple[float, float]], n: int, seed: int, optimization: str,
-              out, provenance: dict, unit: str) -> pd.DataFrame:
-    """Write the optimal LHS of one drive as Parquet; the criteria go into the file metadata."""
-    from dataclasses import asdict
-
-    from .io import write_parquet
-
-    df, criteria = optimal_lhs(bounds, n, seed, optimization, prefix=f"{unit}-lhs")
-    write_parquet(df, out, provenance=provenance,
-                  meta={"unit": unit, "seed": seed, "optimization": optimization, "n": n,
-                        "bounds_mm": bounds, "space_filling": asdict(criteria)})
-    return df

@@ -66,7 +66,7 @@ load step.  A run that does not converge returns status "failed" with a reason.
 Half model (``mesh.symmetry == "half"``, hand-written): the drive and its load are
 invariant under the rotation by pi about the axis (even tooth and ball counts, pi-periodic
 cam, torque), so the solution satisfies u(-x) = -u(x) and only the upper half of every
-body is meshed (``hdwf.mesh``).  On the cut every node at (-x, 0) is tied to its partner
+body is meshed (``hdwf.drive.mesh``).  On the cut every node at (-x, 0) is tied to its partner
 at (x, 0), u = -u_partner: body dofs u = P u_red, and K_red = P^T K P is what is
 factorised (``_solve_body`` maps forces by P^T and displacements by P, so the watch
 vector, the rows and the full fields keep the half-body node numbering).  The symmetric
@@ -112,8 +112,8 @@ from scipy.special import ellipe, ellipk
 from skfem import Basis, ElementTriP1, ElementVector, asm
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
-from .geometry import ARCMIN, DriveGeometry, cam_points
-from .mesh import BodyMesh, DriveMesh
+from hdwf.drive.geometry import ARCMIN, DriveGeometry, cam_points
+from hdwf.drive.mesh import BodyMesh, DriveMesh
 
 TOL_GAP = 1e-5          # mm: 0.01 um allowed penetration
 ZERO_TORQUE_BIAS = 1e-3  # fraction of the test torque used at the zero-torque steps
@@ -130,7 +130,7 @@ class ModelChanges:
     """Physical additions to the baseline model (frictionless flanks, CS clamped on its
     whole outer rim, FS and CS at one temperature, output read on the FS rim).
 
-    ``hdwf.effects`` maps each candidate effect's parameters onto these; every field is a
+    ``hdwf.validation.effects`` maps each candidate effect's parameters onto these; every field is a
     change to the FE model itself:
 
     * ``flank_friction``: Coulomb coefficient on the FS-CS tooth contacts.  A sliding pair's
@@ -1385,7 +1385,7 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
     active-set iterations per load level (a run that hits it returns status "failed");
     ``keep_fields`` also returns the displacement of every node after the wave generator
     is mounted (``wg``) and at +T (``plus``); ``changes`` switches on physical additions
-    to the baseline model (``ModelChanges``, set by ``hdwf.effects``).
+    to the baseline model (``ModelChanges``, set by ``hdwf.validation.effects``).
     """
     changes = ModelChanges() if changes is None else changes
     t0 = time.perf_counter()

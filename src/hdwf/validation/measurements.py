@@ -22,8 +22,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from . import PARAMETER_COLUMNS, PARAMETERS, UNITS
-from .errors import InputError
+from hdwf import PARAMETER_COLUMNS, PARAMETERS, UNITS
+from hdwf.common.errors import InputError
+from hdwf.drive.geometry import unit_data
 
 ID_COLUMNS = ["specimen_id", "unit", *PARAMETER_COLUMNS]
 FORMS = {
@@ -40,7 +41,7 @@ _WRONG_UNITS = {
 }
 # Table 3 bounds of each drive; the model is supported one span beyond them on each side,
 # and never for negative clearance or offsets (interference is outside the model's assumptions).
-_TABLE3 = {
+TABLE3_BOUNDS = {
     "hd42": {"d": (31.0, 31.016), "D": (41.984, 42.0), "Gr": (0.005, 0.02), "rFS": (0.0, 0.02), "rCS": (0.0, 0.02)},
     "hd120": {"d": (90.0, 90.022), "D": (119.978, 120.0), "Gr": (0.0, 0.055), "rFS": (0.025, 0.055),
               "rCS": (0.025, 0.055)},
@@ -48,15 +49,13 @@ _TABLE3 = {
 
 
 def lost_motion_test_torque_Nm(unit: str) -> float:
-    """The test torque, 4 % of T_N, from the drive table of ``hdwf.geometry``."""
-    from .geometry import _UNIT_TABLE
-
-    return _UNIT_TABLE[unit].torque_Nmm / 1000.0
+    """The test torque, 4 % of T_N, from the drive table of ``hdwf.drive.geometry``."""
+    return unit_data(unit).torque_Nmm / 1000.0
 
 
 def supported_bounds(unit: str) -> dict[str, tuple[float, float]]:
     out = {}
-    for p, (lo, hi) in _TABLE3[unit].items():
+    for p, (lo, hi) in TABLE3_BOUNDS[unit].items():
         span = hi - lo
         lo2, hi2 = lo - span, hi + span
         if p in ("Gr", "rFS", "rCS"):

@@ -1,7 +1,7 @@
 """Which physical effect is the model missing? Calibrate every candidate, rank, decide.
 
-Inputs: checked measurements (``hdwf.measurements``) and the per-specimen tables of the FE
-model (``hdwf.campaign``): the campaign's model and, for every candidate effect, the model
+Inputs: checked measurements (``hdwf.validation.measurements``) and the per-specimen tables of the FE
+model (``hdwf.validation.campaign``): the campaign's model and, for every candidate effect, the model
 with that effect at each value of its parameter's grid.
 
 Method (hand-written around scipy/statsmodels; see docs/validation.md):
@@ -18,7 +18,7 @@ Method (hand-written around scipy/statsmodels; see docs/validation.md):
 * evidence: ΔBIC against the model without the candidate, the leave-one-specimen-out error
   (recalibrated without that specimen), and how well the change the effect makes lines up
   with the residual it should explain (cosine: 1 = the same pattern);
-* verdict (``hdwf.validation.verdict``): a candidate pays when ΔBIC <= -10 and its
+* verdict (``hdwf.validation.comparison.verdict``): a candidate pays when ΔBIC <= -10 and its
   leave-one-out error beats the current model's; paying candidates within ΔBIC 6 of the
   best are reported as indistinguishable; none paying -> "no missing effect found";
 * greedy: the winner is switched on and the search repeats for the next effect;
@@ -41,9 +41,9 @@ import pandas as pd
 from scipy.interpolate import make_interp_spline
 from scipy.optimize import least_squares
 
-from .campaign import mean_lost_motion, variant_key
-from .effects import get as get_effect
-from .validation import Candidate, bic, comparison_points, residual_tests, summarise, verdict
+from hdwf.validation.campaign import mean_lost_motion, variant_key
+from hdwf.validation.effects import get as get_effect
+from hdwf.validation.comparison import Candidate, bic, comparison_points, residual_tests, summarise, verdict
 
 
 # ------------------------------------------------------------------ observations
@@ -411,7 +411,7 @@ def plan_detectability(unit: str, specimens: pd.DataFrame, settings: dict, steps
     Solves the campaign tables of ``specimens`` (the baseline model and every candidate's
     grid, as a campaign would) and evaluates ``detectability`` on the curve form of the
     test (every step of every specimen) with ``noise_arcmin`` per point."""
-    from .campaign import candidate_names, plan_variants, specimen_solver
+    from hdwf.validation.campaign import candidate_names, plan_variants, specimen_solver
 
     if not (noise_arcmin > 0 and math.isfinite(noise_arcmin)):
         raise ValueError(f"noise_arcmin must be > 0, got {noise_arcmin!r}")
@@ -453,14 +453,14 @@ def diagnose(meas, table: pd.DataFrame, fixed: dict | None = None, calibrate_fir
     (one row per observation: measured ``D``, the campaign model ``S_model`` and the model
     with every found effect at its calibrated value ``S_final``).
 
-    With ``solve`` (variants -> table rows of every specimen, ``hdwf.campaign.specimen_solver``)
+    With ``solve`` (variants -> table rows of every specimen, ``hdwf.validation.campaign.specimen_solver``)
     every effect switched on before a round (calibrated first, or found in the previous round)
     that needs a contact solve (not the series ones, exact in the tables) is recalibrated on
     actual solves around its estimate (``refine_fit``), so that the round's candidates are
     weighed against the FE model, not against the tables' interpolation error; after the last
     round the ladder's actual solves check the result. Without ``solve``, the tables' splines
     serve throughout. ``refinement`` in the result says what was solved where."""
-    from .campaign import candidate_names
+    from hdwf.validation.campaign import candidate_names
 
     fixed = dict(fixed or {})
     calibrate_first = list(calibrate_first or [])
@@ -658,9 +658,9 @@ def diagnosis_stage(measurements_path, table_paths, plan, out_json, out_points, 
                     jobs: int = 1) -> dict:
     """Diagnose one campaign from its measurement file and per-specimen tables; the solves
     that anchor an effect found before the next round run here, in ``jobs`` processes."""
-    from .campaign import specimen_solver
-    from .io import write_json, write_parquet
-    from .measurements import load_measurements
+    from hdwf.validation.campaign import specimen_solver
+    from hdwf.common.io import write_json, write_parquet
+    from hdwf.validation.measurements import load_measurements
 
     meas = load_measurements(measurements_path)
     table = pd.concat([pd.read_parquet(p) for p in table_paths], ignore_index=True)
@@ -682,9 +682,9 @@ def ladder_stage(measurements_path, diagnosis_json, table_paths, out, provenance
     table lacks it, i.e. for the found effects at their calibrated values."""
     import json
 
-    from .campaign import solve_specimens
-    from .io import write_parquet
-    from .measurements import load_measurements
+    from hdwf.validation.campaign import solve_specimens
+    from hdwf.common.io import write_parquet
+    from hdwf.validation.measurements import load_measurements
 
     meas = load_measurements(measurements_path)
     diag = json.loads(open(diagnosis_json).read())

@@ -15,9 +15,9 @@ import numpy as np
 import pandas as pd
 import pyarrow as pa
 
-from . import PARAMETER_COLUMNS
-from .io import write_parquet
-from .paper import load_fea_designs
+from hdwf import PARAMETER_COLUMNS
+from hdwf.common.io import write_parquet
+from hdwf.study.paper import load_fea_designs
 
 CORE_COLUMNS = ["design_id", *PARAMETER_COLUMNS, "phi_plus_arcmin", "phi_minus_arcmin",
                 "lost_motion_arcmin", "status"]
@@ -56,13 +56,6 @@ def write_lost_motion(df: pd.DataFrame, path: str | Path, provenance: dict, meta
     extra = df[[c for c in df.columns if c not in CORE_COLUMNS]]
     return write_parquet(df, path, provenance=provenance, meta=meta,
                          schema=lost_motion_schema(extra if len(extra.columns) else None))
-
-
-def paper_lost_motion_stage(data_dir: str | Path, unit: str, out: str | Path, provenance: dict) -> Path:
-    """The paper's Table 4/5 as a study's lost-motion table (its Ansys FEA results)."""
-    df = load_fea_designs(data_dir, unit)
-    df["status"] = "published"
-    return write_lost_motion(df, out, provenance, meta={"source": f"paper {unit} FEA table", "unit": unit})
 
 
 def read_lost_motion(path: str | Path) -> pd.DataFrame:

@@ -1,7 +1,7 @@
 """The paper's quadratic response surface (Eq. 11): 1 + 5 linear + 10 interaction + 5 square
 terms = 21 coefficients, fitted by least squares on inputs scaled to [-1, 1] over the study
 bounds (scaling keeps the normal equations well conditioned and makes the coefficients
-directly usable for the exact Sobol indices of ``hdwf.sobol``)."""
+directly usable for the exact Sobol indices of ``hdwf.study.sobol``)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from itertools import combinations
 
 import numpy as np
 
-from . import PARAMETERS
+from hdwf import PARAMETERS
 
 
 def term_names(parameters=PARAMETERS) -> list[str]:
@@ -94,35 +94,6 @@ def fit_quadratic(X: np.ndarray, y: np.ndarray, lower, upper, bounds_source: str
         q2_loo=1.0 - press / ss_tot, rmse=float(np.sqrt(np.mean(resid ** 2))), bounds_source=bounds_source,
         extra={"max_leverage": float(h.max())},
     )
-
-
-def surrogate_stage(lost_motion_path, out_json, out_png, bounds_source: str, table3: dict, title: str,
-                    provenance: dict) -> QuadraticSurrogate:
-    """Fit Eq. 11 on the designs with a result; ``bounds_source`` is ``table3`` (the study's
-    bounds) or ``design_range`` (the span of the design points: the surrogate is then
-    never integrated outside its data)."""
-    import pandas as pd
-
-    from . import PARAMETER_COLUMNS
-    from .io import write_json
-    from .plots import surrogate_figure
-
-    designs = pd.read_parquet(lost_motion_path)
-    ok = designs[designs["lost_motion_arcmin"].notna()]
-    X = ok[list(PARAMETER_COLUMNS)].to_numpy(float)
-    y = ok["lost_motion_arcmin"].to_numpy(float)
-    if bounds_source == "table3":
-        lower = [table3[p][0] for p in PARAMETERS]
-        upper = [table3[p][1] for p in PARAMETERS]
-    elif bounds_source == "design_range":
-        lower, upper = X.min(axis=0), X.max(axis=0)
-    else:
-        raise ValueError(f"unknown bounds source '{bounds_source}': use table3 or design_range")
-    model = fit_quadratic(X, y, lower, upper, bounds_source)
-    model.extra["n_failed_designs"] = int(len(designs) - len(ok))
-    write_json({**model.to_dict(), "provenance": provenance}, out_json)
-    surrogate_figure(ok, model.predict(X), title, out_png)
-    return model
 
 
 def rebound(model: QuadraticSurrogate, lower, upper, bounds_source: str) -> QuadraticSurrogate:

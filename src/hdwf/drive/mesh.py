@@ -8,7 +8,7 @@ Four separate bodies, meshed with linear triangles and returned as scikit-fem ``
 * ``or``  bearing outer ring: raceway D1 to outer diameter D (sits in the FS bore).
 
 The balls are NOT meshed: each is a discrete unilateral Hertz element between the two
-raceways (see ``hdwf.fe``); the cam is a rigid analytic curve (``hdwf.geometry``), not
+raceways (see ``hdwf.fe``); the cam is a rigid analytic curve (``hdwf.drive.geometry``), not
 meshed either.  Only the contact surfaces need to be named; physical groups:
 ``fs_bore``, ``fs_teeth`` (flanks, tips and roots), ``cs_teeth``, ``cs_outer`` (support),
 ``ir_bore``, ``ir_race``, ``or_race``, ``or_outer`` and one surface group per body.
@@ -17,7 +17,7 @@ Density follows the paper (Sec. 4): each tooth flank is split into ``elements_ov
 segments and the tooth thickness at the pitch circle into ``elements_over_thickness``;
 the rim grades to about twice that size at the FS bore and to a coarse size at the CS
 outer rim.  ``refinement`` multiplies every element count (divides every size).
-Hand-written parts: only the tooth outlines (involute points from ``hdwf.geometry``) and
+Hand-written parts: only the tooth outlines (involute points from ``hdwf.drive.geometry``) and
 the conversion of gmsh's arrays into per-body scikit-fem meshes.
 
 Half model (``symmetry="half"``): the drive is point-symmetric under a rotation by pi
@@ -39,7 +39,7 @@ import gmsh
 import numpy as np
 from skfem import MeshTri
 
-from .geometry import DriveGeometry, cs_half_space_angle, fs_half_angle
+from hdwf.drive.geometry import DriveGeometry, cs_half_space_angle, fs_half_angle
 
 MESH_ALGORITHM = 6   # gmsh 2D: 6 = Frontal-Delaunay (quality); 5 = Delaunay
 

@@ -14,7 +14,7 @@ Reuse between candidates (what makes a campaign affordable):
   cup torsion, Oldham play) share one contact solve: their twist is the solved rim twist
   plus the series element's, exactly;
 * the calibration of every candidate reads the per-specimen tables (each parameter's grid),
-  so it costs no solve at all (``hdwf.diagnosis``).
+  so it costs no solve at all (``hdwf.validation.diagnosis``).
 """
 
 from __future__ import annotations
@@ -28,11 +28,11 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 import pandas as pd
 
-from . import PARAMETER_COLUMNS
-from .effects import get as get_effect
-from .effects import model_changes, registry
-from .fe import ModelChanges, series_output_twist
-from .geometry import ARCMIN
+from hdwf import PARAMETER_COLUMNS
+from hdwf.validation.effects import get as get_effect
+from hdwf.validation.effects import model_changes, registry
+from hdwf.fe import ModelChanges, series_output_twist
+from hdwf.drive.geometry import ARCMIN
 
 BASELINE = "baseline"
 _BLAS_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
@@ -83,8 +83,8 @@ def solve_variants(unit: str, params: dict[str, float], mesh, steps_per_ramp: in
     """Solve one specimen for every variant (one contact solve per distinct FE part).
 
     A variant whose solve fails gets ``status = "failed: <reason>"`` and NaN twists."""
-    from .fe import solve_lost_motion_variants
-    from .fe_study import geometry_of
+    from hdwf.fe import solve_lost_motion_variants
+    from hdwf.drive.design import geometry_of
 
     geom = geometry_of(unit, params)
     changes = [model_changes(eff) for eff in variants]
@@ -112,9 +112,9 @@ def solve_variants(unit: str, params: dict[str, float], mesh, steps_per_ramp: in
 
 def _specimen_job(args):
     unit, params, settings, steps, variants, sid = args
-    from .fe_study import _mesh, geometry_of
+    from hdwf.drive.design import mesh_design
 
-    mesh = _mesh(geometry_of(unit, params), settings)
+    mesh = mesh_design(unit, params, settings)
     return solve_variants(unit, params, mesh, steps, variants, sid)
 
 
@@ -166,7 +166,7 @@ def synth_designs(unit: str, n: int, seed: int,
     like the one on the bench rather than the paper's design space (docs/validation.md)."""
     from scipy.stats import qmc
 
-    from . import PARAMETERS
+    from hdwf import PARAMETERS
 
     bounds = design_ranges(unit, ranges)
     lo = np.array([bounds[c][0] for c in PARAMETER_COLUMNS])
@@ -182,11 +182,11 @@ def synth_designs(unit: str, n: int, seed: int,
 def design_ranges(unit: str, ranges: dict[str, tuple[float, float]] | None = None) -> dict[str, tuple[float, float]]:
     """The sampling range of every parameter column: Table 3's, replaced by ``ranges`` where
     given. A range must lie inside what the model supports (``measurements.supported_bounds``)."""
-    from .measurements import _TABLE3, supported_bounds
+    from hdwf.validation.measurements import TABLE3_BOUNDS, supported_bounds
 
-    if unit not in _TABLE3:
-        raise ValueError(f"unknown drive {unit!r}; known: {', '.join(_TABLE3)}")
-    out = {f"{p}_mm": (float(lo), float(hi)) for p, (lo, hi) in _TABLE3[unit].items()}
+    if unit not in TABLE3_BOUNDS:
+        raise ValueError(f"unknown drive {unit!r}; known: {', '.join(TABLE3_BOUNDS)}")
+    out = {f"{p}_mm": (float(lo), float(hi)) for p, (lo, hi) in TABLE3_BOUNDS[unit].items()}
     supported = {f"{p}_mm": b for p, b in supported_bounds(unit).items()}
     for col, (lo, hi) in (ranges or {}).items():
         if col not in out:
@@ -300,12 +300,12 @@ def campaign_plan(name: str, camp: dict, fe: dict) -> CampaignPlan:
 def specimen_stage(unit: str, specimen: dict, settings: dict, steps_per_ramp: int, variants: list[dict],
                    out, provenance: dict) -> pd.DataFrame:
     """Mesh one specimen once and solve it for every variant (one campaign table)."""
-    from .fe_study import _mesh, geometry_of
-    from .io import write_parquet
+    from hdwf.drive.design import mesh_design
+    from hdwf.common.io import write_parquet
 
     sid = specimen["specimen_id"]
     params = {c: float(specimen[c]) for c in PARAMETER_COLUMNS}
-    mesh = _mesh(geometry_of(unit, params), settings)
+    mesh = mesh_design(unit, params, settings)
     table = solve_variants(unit, params, mesh, steps_per_ramp, variants, sid)[TABLE_COLUMNS]
     write_parquet(table, out, provenance=provenance,
                   meta={"unit": unit, "specimen_id": sid, "mesh": settings})

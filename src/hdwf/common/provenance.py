@@ -7,7 +7,7 @@ import subprocess
 from importlib import metadata
 from pathlib import Path
 
-from .config import config_hash
+from hdwf.config import config_hash
 
 _PACKAGES = ("hdwf", "snakemake", "numpy", "scipy", "pandas", "scikit-fem", "gmsh", "SALib",
              "statsmodels", "pyarrow", "matplotlib", "typst")

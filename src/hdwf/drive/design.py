@@ -1,0 +1,110 @@
+"""One design, from its table row to a mesh: parameters -> ``DriveGeometry`` -> ``DriveMesh``.
+
+The mesh settings live here in one dataclass (``MeshSettings``) so every caller — the FE study,
+the validation campaigns, the CLI and the benchmarks — meshes the same way.  A mesh is stored as
+``.npz`` (nodes, triangles, named node and edge sets of each body) so a solve never re-meshes.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Mapping
+
+import numpy as np
+import pandas as pd
+from skfem import MeshTri
+
+from hdwf import PARAMETER_COLUMNS
+from hdwf.common.io import atomic_path
+from hdwf.drive.geometry import DriveGeometry, drive_geometry
+from hdwf.drive.mesh import BodyMesh, DriveMesh, build_mesh
+
+
+@dataclass(frozen=True)
+class MeshSettings:
+    """How fine the section is meshed and which part of it is modelled.
+
+    ``elements_over_height`` and ``elements_over_thickness`` are counts over a tooth (the
+    paper's rule is 10 and 6); ``refinement`` multiplies both; ``symmetry`` is ``"full"`` or
+    ``"half"`` (the half section with its cut tied, see ``docs/fe-model.md``).
+    """
+
+    elements_over_height: int = 10
+    elements_over_thickness: int = 6
+    refinement: float = 1.0
+    symmetry: str = "full"
+
+    @classmethod
+    def from_mapping(cls, settings: Mapping) -> "MeshSettings":
+        """Settings from a config-style mapping; keys it does not name keep their defaults."""
+        known = {k: settings[k] for k in ("elements_over_height", "elements_over_thickness", "refinement",
+                                          "symmetry") if k in settings}
+        return cls(**known)
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+    def mesh(self, geom: DriveGeometry, path: str | None = None) -> DriveMesh:
+        """Mesh ``geom``; with ``path`` gmsh also writes its ``.msh`` there."""
+        return build_mesh(geom, self.elements_over_height, self.elements_over_thickness, self.refinement,
+                          path=path, symmetry=self.symmetry)
+
+
+def design_parameters(designs_path, design_id: str) -> dict[str, float]:
+    """The five parameters (``d_mm`` … ``rCS_mm``) of one design of a design table."""
+    df = pd.read_parquet(designs_path)
+    row = df[df["design_id"] == design_id]
+    if len(row) != 1:
+        raise KeyError(f"{designs_path}: design '{design_id}' not found (have {len(df)} designs)")
+    return {c: float(row.iloc[0][c]) for c in PARAMETER_COLUMNS}
+
+
+def geometry_of(unit: str, params: Mapping[str, float]) -> DriveGeometry:
+    """The drive geometry of ``unit`` at the design parameters ``params`` (keys ``d_mm`` …)."""
+    return drive_geometry(unit, params["d_mm"], params["D_mm"], params["Gr_mm"], params["rFS_mm"], params["rCS_mm"])
+
+
+def mesh_design(unit: str, params: Mapping[str, float], settings: Mapping | MeshSettings) -> DriveMesh:
+    """Mesh one design with the given settings (a ``MeshSettings`` or a config mapping)."""
+    if not isinstance(settings, MeshSettings):
+        settings = MeshSettings.from_mapping(settings)
+    return settings.mesh(geometry_of(unit, params))
+
+
+def save_drive_mesh(mesh: DriveMesh, path) -> Path:
+    """Write ``mesh`` as ``.npz`` (atomically)."""
+    arrays = {"__sizes__": np.array(json.dumps(mesh.sizes))}
+    for name, body in mesh.bodies.items():
+        arrays[f"{name}:p"] = body.mesh.p
+        arrays[f"{name}:t"] = body.mesh.t
+        arrays[f"{name}:thickness"] = np.array(body.thickness)
+        for k, v in body.node_sets.items():
+            arrays[f"{name}:node:{k}"] = np.asarray(v)
+        for k, v in body.edge_sets.items():
+            arrays[f"{name}:edge:{k}"] = np.asarray(v)
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez_compressed(fh, **arrays)
+    return Path(path)
+
+
+def load_drive_mesh(path) -> DriveMesh:
+    """Read a mesh written by ``save_drive_mesh``."""
+    data = np.load(path)
+    bodies: dict[str, dict] = {}
+    for key in data.files:
+        if key == "__sizes__":
+            continue
+        name, kind, *rest = key.split(":")
+        b = bodies.setdefault(name, {"node_sets": {}, "edge_sets": {}})
+        if kind in ("p", "t", "thickness"):
+            b[kind] = data[key]
+        elif kind == "node":
+            b["node_sets"][rest[0]] = data[key]
+        elif kind == "edge":
+            b["edge_sets"][rest[0]] = data[key]
+    out = {name: BodyMesh(name=name, mesh=MeshTri(b["p"], b["t"]), thickness=float(b["thickness"]),
+                          node_sets=b["node_sets"], edge_sets=b["edge_sets"]) for name, b in bodies.items()}
+    return DriveMesh(bodies=out, sizes=json.loads(str(data["__sizes__"])))

@@ -1,0 +1,112 @@
+"""Stages of the FE studies (rules in ``workflow/rules/fe.smk``): design table, per-design mesh
+and solve, aggregation, mesh convergence and the deformed-mesh picture.
+
+A design's mesh is written twice: gmsh's ``.msh`` for review and ``.npz`` that the solve stage
+reads back, so a solve never re-meshes.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Mapping
+
+import numpy as np
+import pandas as pd
+
+from hdwf import PARAMETER_COLUMNS
+from hdwf.common.io import atomic_path, read_parquet_meta, write_parquet
+from hdwf.drive.design import (MeshSettings, design_parameters, geometry_of, load_drive_mesh, mesh_design,
+                               save_drive_mesh)
+from hdwf.fe import solve_lost_motion
+from hdwf.report.figures import deformed_figure
+from hdwf.study.aggregate import write_lost_motion
+from hdwf.study.convergence import convergence_table
+from hdwf.study.fe_design import solve_design
+from hdwf.study.paper import load_fea_designs
+
+
+def designs_stage(source: str, unit: str, source_path, data_dir, out, provenance: dict) -> pd.DataFrame:
+    """The design table an FE study solves: our optimal LHS (``doe``) or the paper's points (``paper``)."""
+    if source == "paper":
+        df = load_fea_designs(data_dir, unit)[["design_id", *PARAMETER_COLUMNS]]
+        meta = {"source": "paper Table 4/5 design points", "unit": unit}
+    else:
+        df = pd.read_parquet(source_path)
+        meta = {"source": "hdwf optimal LHS", "unit": unit, **(read_parquet_meta(source_path)[1] or {})}
+    write_parquet(df, out, provenance=provenance, meta=meta)
+    return df
+
+
+def mesh_stage(designs_path, design_id: str, unit: str, settings: Mapping, out_msh, out_npz) -> dict:
+    """Mesh one design: gmsh ``.msh`` for review, ``.npz`` for the solver; returns mesh facts."""
+    geom = geometry_of(unit, design_parameters(designs_path, design_id))
+    t0 = time.perf_counter()
+    with atomic_path(out_msh) as tmp_msh:
+        # gmsh picks the format from the extension, so the temporary name keeps ".msh".
+        tmp_named = tmp_msh.with_suffix(".msh")
+        mesh = MeshSettings.from_mapping(settings).mesh(geom, path=str(tmp_named))
+        tmp_named.replace(tmp_msh)
+    save_drive_mesh(mesh, out_npz)
+    return {"design_id": design_id, "n_nodes": mesh.n_nodes, "mesh_s": time.perf_counter() - t0}
+
+
+def solve_stage(designs_path, design_id: str, unit: str, mesh_npz, steps_per_ramp: int, out_row, out_curve,
+                provenance: dict) -> dict:
+    """Solve one meshed design into its row and torque–twist curve (Parquet each)."""
+    params = design_parameters(designs_path, design_id)
+    row, curve = solve_design(unit, params, load_drive_mesh(mesh_npz), steps_per_ramp, design_id)
+    write_parquet(pd.DataFrame([row]), out_row, provenance=provenance, meta={"unit": unit})
+    write_parquet(curve, out_curve, provenance=provenance, meta={"unit": unit})
+    return row
+
+
+def aggregate_stage(row_paths, curve_paths, out_lost_motion, out_curves, provenance: dict, meta: dict) -> pd.DataFrame:
+    """All designs' rows into ``lost_motion.parquet`` and their curves into ``curves.parquet``."""
+    rows = pd.concat([pd.read_parquet(p) for p in row_paths], ignore_index=True)
+    curves = pd.concat([pd.read_parquet(p) for p in curve_paths], ignore_index=True)
+    write_lost_motion(rows, out_lost_motion, provenance, meta=meta)
+    write_parquet(curves.sort_values(["design_id", "step"]).reset_index(drop=True), out_curves,
+                  provenance=provenance, meta=meta)
+    return rows
+
+
+def refined_solve_stage(designs_path, design_id: str, unit: str, settings: Mapping, steps_per_ramp: int, out,
+                        provenance: dict) -> dict:
+    """Mesh and solve one design at another refinement (mesh-convergence runs); one row out."""
+    params = design_parameters(designs_path, design_id)
+    row, _ = solve_design(unit, params, mesh_design(unit, params, settings), steps_per_ramp, design_id)
+    row["refinement"] = float(settings["refinement"])
+    write_parquet(pd.DataFrame([row]), out, provenance=provenance, meta={"unit": unit})
+    return row
+
+
+def convergence_stage(default_lost_motion, other_rows, default_refinement: float, out, provenance: dict,
+                      meta: dict) -> pd.DataFrame:
+    """Φ of every design on each mesh, the relative change and the GCI (``convergence.parquet``)."""
+    default = pd.read_parquet(default_lost_motion).assign(refinement=float(default_refinement))
+    others = pd.concat([pd.read_parquet(p) for p in other_rows], ignore_index=True)
+    cols = ["design_id", "refinement", "h_tooth_mm", "lost_motion_arcmin"]
+    results = pd.concat([default[cols], others[cols]], ignore_index=True).rename(columns={"h_tooth_mm": "h_mm"})
+    table = convergence_table(results)
+    write_parquet(table, out, provenance=provenance, meta={**meta, "criterion": "two finest meshes differ < 2 %"})
+    return table
+
+
+def deformed_stage(designs_path, design_id: str, unit: str, settings: Mapping, steps_per_ramp: int, out_png,
+                   out_npz, provenance: dict) -> dict:
+    """Solve one design keeping the displacement fields; picture of the mesh near the major axis."""
+    params = design_parameters(designs_path, design_id)
+    geom = geometry_of(unit, params)
+    mesh = MeshSettings.from_mapping(settings).mesh(geom)
+    res = solve_lost_motion(geom, mesh, steps_per_ramp=steps_per_ramp, keep_fields=True)
+    if res.status != "ok":
+        raise RuntimeError(f"{design_id}: solve failed ({res.reason}); no picture of a failed state")
+    arrays = {f"{state}:{body}": u for state, per_body in res.fields.items() for body, u in per_body.items()}
+    with atomic_path(out_npz) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez_compressed(fh, **arrays)
+    pitch = 2 * np.pi * geom.r_fs_pitch / geom.z_fs
+    deformed_figure(mesh, res.fields, f"{unit} {design_id} at +4 % T_N (Φ = {res.lost_motion_arcmin:.3f} arcmin), "
+                    "true scale", out_png, half_width_mm=2.5 * pitch,
+                    xlim=(geom.r_fs_bore - 2 * geom.module, geom.r_cs_root + 3 * geom.module))
+    return {"design_id": design_id, "lost_motion_arcmin": res.lost_motion_arcmin}
