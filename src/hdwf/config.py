@@ -6,7 +6,6 @@ reads the file, the dotted key path, the value and what was expected.
 
 from __future__ import annotations
 
-import hashlib
 import json
 from pathlib import Path
 
@@ -14,6 +13,8 @@ import jsonschema
 import yaml
 
 from hdwf.common.errors import ConfigError
+from hdwf.common.provenance import config_hash  # noqa: F401  (re-exported: `hdwf check-config` prints it)
+from hdwf.validation.effects import registry
 
 
 def _key_path(error: jsonschema.ValidationError) -> str:
@@ -81,8 +82,6 @@ def _check_relations(config: dict, source) -> None:
 
 def _check_campaign(name: str, camp: dict, source) -> None:
     """Effect names, parameters and values of a campaign against the effects registry."""
-    from hdwf.validation.effects import registry
-
     known = registry()
     where = f"validation.{name}"
     for eff, params in camp.get("effects", {}).items():
@@ -119,9 +118,3 @@ def load_config(path: str | Path, schema_path: str | Path) -> dict:
     except yaml.YAMLError as exc:
         raise ConfigError(path, f"not valid YAML: {exc}") from exc
     return validate_config(config, schema_path, path)
-
-
-def config_hash(config: dict) -> str:
-    """SHA-256 of the canonical JSON of a config: same config, same hash, whatever the key order."""
-    canonical = json.dumps(config, sort_keys=True, separators=(",", ":"), default=str)
-    return hashlib.sha256(canonical.encode()).hexdigest()

@@ -5,7 +5,7 @@ from _helpers import mock_snakemake, setup
 
 from hdwf.stages.stats import correlation_stage
 
-if "snakemake" not in globals():  # run outside Snakemake, from the project root
+if "snakemake" not in globals():  # run by hand, e.g. to debug one step (see _helpers.mock_snakemake)
     snakemake = mock_snakemake("correlation", study="paper", unit="hd42")
 
 prov = setup(snakemake)

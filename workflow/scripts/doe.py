@@ -1,4 +1,4 @@
-"""Rule doe: Table 3 bounds -> optimal LHS (hdwf.study.doe.doe_stage)."""
+"""Rule doe: Table 3 bounds -> optimal LHS (hdwf.stages.doe.doe_stage)."""
 import logging
 
 from _helpers import mock_snakemake, setup
@@ -6,7 +6,7 @@ from _helpers import mock_snakemake, setup
 from hdwf.stages.doe import doe_stage
 from hdwf.study.paper import table3_bounds
 
-if "snakemake" not in globals():  # run outside Snakemake, from the project root
+if "snakemake" not in globals():  # run by hand, e.g. to debug one step (see _helpers.mock_snakemake)
     snakemake = mock_snakemake("doe", unit="hd42")
 
 prov = setup(snakemake)

@@ -4,11 +4,8 @@ from _helpers import mock_snakemake, setup
 
 from hdwf.stages.fe import designs_stage
 
-if "snakemake" not in globals():  # run outside Snakemake, from the project root
+if "snakemake" not in globals():  # run by hand, e.g. to debug one step (see _helpers.mock_snakemake)
     snakemake = mock_snakemake("fe_designs", study="fe", unit="hd42")
-
-import sys
-
 
 prov = setup(snakemake)
 designs_stage(snakemake.params.designs, snakemake.wildcards.unit, snakemake.input[0],

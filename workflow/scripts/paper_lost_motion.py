@@ -5,8 +5,8 @@ from _helpers import mock_snakemake, setup
 
 from hdwf.stages.paper import paper_lost_motion_stage
 
-if "snakemake" not in globals():  # run outside Snakemake, from the project root
-    snakemake = mock_snakemake("paper_lost_motion", unit="hd42")
+if "snakemake" not in globals():  # run by hand, e.g. to debug one step (see _helpers.mock_snakemake)
+    snakemake = mock_snakemake("paper_lost_motion", study="paper", unit="hd42")
 
 prov = setup(snakemake)
 paper_lost_motion_stage(snakemake.params.data_dir, snakemake.wildcards.unit, snakemake.output[0], prov)

@@ -7,7 +7,7 @@ from hdwf import PARAMETERS
 from hdwf.study.paper import table3_bounds
 from hdwf.stages.stats import sobol_stage
 
-if "snakemake" not in globals():  # run outside Snakemake, from the project root
+if "snakemake" not in globals():  # run by hand, e.g. to debug one step (see _helpers.mock_snakemake)
     snakemake = mock_snakemake("sobol", study="paper", unit="hd42")
 
 prov = setup(snakemake)

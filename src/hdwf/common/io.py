@@ -13,11 +13,14 @@ import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-PROVENANCE_KEY = b"hdwf.common.provenance"
+from hdwf.common.errors import InputError
+
+PROVENANCE_KEY = b"hdwf.provenance"
 EXTRA_KEY = b"hdwf.meta"
 
 
@@ -86,7 +89,6 @@ def write_json(obj, path: str | Path) -> Path:
 
 
 def _json_default(o):
-    import numpy as np
     if isinstance(o, np.generic):
         return o.item()
     if isinstance(o, np.ndarray):
@@ -105,9 +107,6 @@ def read_table(path: str | Path, required: dict[str, str]) -> pd.DataFrame:
     Raises InputError naming the file, the 1-based data row and the column of the first
     bad value; a missing column is named with the columns that were found.
     """
-    from hdwf.common.errors import InputError
-    import numpy as np
-
     path = Path(path)
     if not path.exists():
         raise InputError(path, "file not found")

@@ -2,18 +2,25 @@
 
 from __future__ import annotations
 
+import hashlib
+import json
 import platform
 import subprocess
 from importlib import metadata
 from pathlib import Path
 
-from hdwf.config import config_hash
-
 _PACKAGES = ("hdwf", "snakemake", "numpy", "scipy", "pandas", "scikit-fem", "gmsh", "SALib",
              "statsmodels", "pyarrow", "matplotlib", "typst")
 
 
+def config_hash(config: dict) -> str:
+    """SHA-256 of the canonical JSON of a config: same config, same hash, whatever the key order."""
+    canonical = json.dumps(config, sort_keys=True, separators=(",", ":"), default=str)
+    return hashlib.sha256(canonical.encode()).hexdigest()
+
+
 def package_versions() -> dict[str, str]:
+    """Installed versions of the packages that shape the results."""
     versions = {}
     for name in _PACKAGES:
         try:
@@ -36,6 +43,7 @@ def git_commit(repo_dir: str | Path = ".") -> str:
 
 
 def provenance(config: dict, repo_dir: str | Path = ".") -> dict:
+    """What every artefact records: config hash, git commit, Python and package versions."""
     return {
         "config_hash": config_hash(config),
         "git_commit": git_commit(repo_dir),

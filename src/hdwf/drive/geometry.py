@@ -40,7 +40,7 @@ dr sin(alpha) on each flank.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 from scipy.optimize import brentq
@@ -352,7 +352,6 @@ def geometric_backlash_arcmin(g: DriveGeometry, radial_shortfall_mm: float = 0.0
 def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: float,
                    rCS_mm: float) -> DriveGeometry:
     """Geometry of one design of unit "hd42" or "hd120" (all lengths in mm)."""
-    from dataclasses import asdict
     t = asdict(unit_data(unit))
     m = t["module"]
     h = t["tooth_height"]
@@ -391,5 +390,4 @@ def nominal_geometry(unit: str) -> DriveGeometry:
 
 def with_changes(g: DriveGeometry, **kw) -> DriveGeometry:
     """Copy with some fields replaced (e.g. a stiffer E for the rigid-body limit)."""
-    from dataclasses import replace
     return replace(g, **kw)

@@ -184,8 +184,19 @@ def build_mesh(geom: DriveGeometry, elements_over_height: int = 10,
                path: str | None = None, symmetry: str = "full") -> DriveMesh:
     """Mesh the four bodies; write ``path`` (.msh) if given; return per-body meshes.
 
-    ``symmetry="half"`` meshes only the upper half of every body (see the module
-    docstring); ``"full"`` (default) the whole drive."""
+    Parameters
+    ----------
+    geom : the drive's geometry.
+    elements_over_height, elements_over_thickness : elements over a tooth (paper: 10 and 6).
+    refinement : multiplies both counts.
+    path : where gmsh writes its binary ``.msh`` (for review), or None.
+    symmetry : ``"half"`` meshes only the upper half of every body (see the module
+        docstring); ``"full"`` (default) the whole drive.
+
+    Returns
+    -------
+    DriveMesh : the FS, CS and bearing rings with their named node and edge sets.
+    """
     g = geom
     if symmetry not in ("full", "half"):
         raise ValueError(f"symmetry must be 'full' or 'half', not {symmetry!r}")
@@ -200,61 +211,12 @@ def build_mesh(geom: DriveGeometry, elements_over_height: int = 10,
         gmsh.model.add("hd")
         geo = gmsh.model.geo
         c = geo.addPoint(0, 0, 0, 1.0)
-
         groups: dict[str, tuple[int, list[int]]] = {}
         cuts: list[tuple[int, int]] = []     # (line at angle pi, line at angle 0)
-        if half:
-            fs_fl, cs_fl, fs_bore, ir_bore, ir_race, or_race, or_outer, cs_outer = \
-                _half_geometry(geo, g, c, s, groups, cuts)
-        else:
-            # --- FS
-            fs_out, fs_fl = _fs_outline(geo, g, c, s)
-            fs_bore = _circle(geo, g.r_fs_bore, s["fs_bore"], c)
-            fs_surf = geo.addPlaneSurface([geo.addCurveLoop(fs_out), geo.addCurveLoop(fs_bore)])
-            groups["fs"] = (2, [fs_surf])
-            groups["fs_teeth"] = (1, fs_out)
-            groups["fs_bore"] = (1, fs_bore)
-            # --- CS
-            cs_in, cs_fl = _cs_outline(geo, g, c, s)
-            cs_outer = _circle(geo, g.r_cs_outer, s["cs_outer"], c)
-            cs_surf = geo.addPlaneSurface([geo.addCurveLoop(cs_outer), geo.addCurveLoop(cs_in)])
-            groups["cs"] = (2, [cs_surf])
-            groups["cs_teeth"] = (1, cs_in)
-            groups["cs_outer"] = (1, cs_outer)
-            # --- bearing rings
-            ir_bore = _circle(geo, g.ir_bore, s["ring"], c)
-            ir_race = _circle(geo, g.ir_race, s["ring"], c)
-            ir_surf = geo.addPlaneSurface([geo.addCurveLoop(ir_race), geo.addCurveLoop(ir_bore)])
-            or_race = _circle(geo, g.or_race, s["ring"], c)
-            or_outer = _circle(geo, g.or_outer, s["ring"], c)
-            or_surf = geo.addPlaneSurface([geo.addCurveLoop(or_outer), geo.addCurveLoop(or_race)])
-            groups.update({"ir": (2, [ir_surf]), "ir_bore": (1, ir_bore), "ir_race": (1, ir_race),
-                           "or": (2, [or_surf]), "or_race": (1, or_race),
-                           "or_outer": (1, or_outer)})
+        build = _half_geometry if half else _full_geometry
+        curves = build(geo, g, c, s, groups, cuts)
         geo.synchronize()
-        fs_surf, cs_surf = groups["fs"][1][0], groups["cs"][1][0]
-        ir_surf, or_surf = groups["ir"][1][0], groups["or"][1][0]
-        # half model: the cut at angle pi is the image of the cut at angle 0 under the
-        # rotation by pi, so their nodes pair up exactly (u_pi = -u_0 in hdwf.fe)
-        rot_pi = [-1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
-        for slave, master in cuts:
-            gmsh.model.mesh.setPeriodic(1, [slave], [master], rot_pi)
-
-        # transfinite flanks: exactly n_flank segments over the tooth height
-        for cv in fs_fl + cs_fl:
-            gmsh.model.mesh.setTransfiniteCurve(cv, s["n_flank"] + 1)
-        # uniform node spacing on the circular contact surfaces (mortar bins need no
-        # matching, but uniform spacing keeps the bin weights even)
-        def _tf(arcs, r, h):
-            n = max(2, int(math.ceil(0.5 * math.pi * r / h)))
-            for a in arcs:
-                gmsh.model.mesh.setTransfiniteCurve(a, n + 1)
-        _tf(fs_bore, g.r_fs_bore, s["fs_bore"])
-        for arcs, r in ((ir_bore, g.ir_bore), (ir_race, g.ir_race), (or_race, g.or_race),
-                        (or_outer, g.or_outer)):
-            _tf(arcs, r, s["ring"])
-        _tf(cs_outer, g.r_cs_outer, s["cs_outer"])
-
+        _mesh_controls(g, s, curves, cuts)
         for name, (dim, tags) in groups.items():
             gmsh.model.addPhysicalGroup(dim, tags, name=name)
         gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 1)
@@ -263,47 +225,94 @@ def build_mesh(geom: DriveGeometry, elements_over_height: int = 10,
         if path is not None:
             gmsh.option.setNumber("Mesh.Binary", 1)  # 4x smaller and faster to write; gmsh reads it back
             gmsh.write(str(path))
-
         ntags, coords, _ = gmsh.model.mesh.getNodes()
         xy = np.zeros((int(ntags.max()) + 1, 2))
         xy[ntags.astype(np.int64)] = coords.reshape(-1, 3)[:, :2]
-
-        def _body(name, surf, thick, bnames):
-            et, _, enodes = gmsh.model.mesh.getElements(2, surf)
-            tri = np.asarray(enodes[list(et).index(2)], dtype=np.int64).reshape(-1, 3)
-            used = np.unique(tri)
-            loc = -np.ones(xy.shape[0], dtype=np.int64)
-            loc[used] = np.arange(used.size)
-            p = xy[used].T.copy()
-            t = loc[tri].T.copy()
-            # counter-clockwise orientation
-            a = ((p[0, t[1]] - p[0, t[0]]) * (p[1, t[2]] - p[1, t[0]])
-                 - (p[0, t[2]] - p[0, t[0]]) * (p[1, t[1]] - p[1, t[0]]))
-            sw = a < 0
-            t[1, sw], t[2, sw] = t[2, sw].copy(), t[1, sw].copy()
-            bm = BodyMesh(name, MeshTri(p, t), thick)
-            for bn in bnames:
-                edges = []
-                for cv in groups[bn][1]:
-                    et1, _, en1 = gmsh.model.mesh.getElements(1, cv)
-                    edges.append(np.asarray(en1[list(et1).index(1)],
-                                            dtype=np.int64).reshape(-1, 2))
-                e = loc[np.vstack(edges)]
-                bm.edge_sets[bn] = e
-                bm.node_sets[bn] = np.unique(e)
-            return bm
-
-        bodies = {
-            "fs": _body("fs", fs_surf, g.face_fs, ["fs_teeth", "fs_bore"]),
-            "cs": _body("cs", cs_surf, g.face_cs, ["cs_teeth", "cs_outer"]),
-            "ir": _body("ir", ir_surf, g.B, ["ir_bore", "ir_race"]),
-            "or": _body("or", or_surf, g.B, ["or_race", "or_outer"]),
-        }
+        bodies = {name: _extract_body(name, groups, xy, thick, bnames) for name, thick, bnames in (
+            ("fs", g.face_fs, ["fs_teeth", "fs_bore"]), ("cs", g.face_cs, ["cs_teeth", "cs_outer"]),
+            ("ir", g.B, ["ir_bore", "ir_race"]), ("or", g.B, ["or_race", "or_outer"]))}
     finally:
         gmsh.finalize()
     if half:
         s["symmetry_half"] = 1.0
     return DriveMesh(bodies, s, symmetry)
+
+
+def _mesh_controls(g: DriveGeometry, s: dict, curves: tuple, cuts: list) -> None:
+    """Periodic cuts (half model), transfinite flanks and uniform spacing on circular contacts."""
+    fs_fl, cs_fl, fs_bore, ir_bore, ir_race, or_race, or_outer, cs_outer = curves
+    # half model: the cut at angle pi is the image of the cut at angle 0 under the
+    # rotation by pi, so their nodes pair up exactly (u_pi = -u_0 in hdwf.fe)
+    rot_pi = [-1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
+    for slave, master in cuts:
+        gmsh.model.mesh.setPeriodic(1, [slave], [master], rot_pi)
+    # transfinite flanks: exactly n_flank segments over the tooth height
+    for cv in fs_fl + cs_fl:
+        gmsh.model.mesh.setTransfiniteCurve(cv, s["n_flank"] + 1)
+
+    # uniform node spacing on the circular contact surfaces (mortar bins need no
+    # matching, but uniform spacing keeps the bin weights even)
+    def uniform(arcs, r, h):
+        n = max(2, int(math.ceil(0.5 * math.pi * r / h)))
+        for a in arcs:
+            gmsh.model.mesh.setTransfiniteCurve(a, n + 1)
+    uniform(fs_bore, g.r_fs_bore, s["fs_bore"])
+    for arcs, r in ((ir_bore, g.ir_bore), (ir_race, g.ir_race), (or_race, g.or_race), (or_outer, g.or_outer)):
+        uniform(arcs, r, s["ring"])
+    uniform(cs_outer, g.r_cs_outer, s["cs_outer"])
+
+
+def _extract_body(name: str, groups: dict, xy: np.ndarray, thickness: float, boundary_names: list[str]) -> BodyMesh:
+    """One body's triangles (counter-clockwise, local numbering) and its named boundaries."""
+    surf = groups[name][1][0]
+    et, _, enodes = gmsh.model.mesh.getElements(2, surf)
+    tri = np.asarray(enodes[list(et).index(2)], dtype=np.int64).reshape(-1, 3)
+    used = np.unique(tri)
+    loc = -np.ones(xy.shape[0], dtype=np.int64)
+    loc[used] = np.arange(used.size)
+    p = xy[used].T.copy()
+    t = loc[tri].T.copy()
+    a = ((p[0, t[1]] - p[0, t[0]]) * (p[1, t[2]] - p[1, t[0]])
+         - (p[0, t[2]] - p[0, t[0]]) * (p[1, t[1]] - p[1, t[0]]))
+    sw = a < 0
+    t[1, sw], t[2, sw] = t[2, sw].copy(), t[1, sw].copy()
+    bm = BodyMesh(name, MeshTri(p, t), thickness)
+    for bn in boundary_names:
+        edges = []
+        for cv in groups[bn][1]:
+            et1, _, en1 = gmsh.model.mesh.getElements(1, cv)
+            edges.append(np.asarray(en1[list(et1).index(1)], dtype=np.int64).reshape(-1, 2))
+        e = loc[np.vstack(edges)]
+        bm.edge_sets[bn] = e
+        bm.node_sets[bn] = np.unique(e)
+    return bm
+
+
+def _full_geometry(geo, g: DriveGeometry, c: int, s: dict, groups: dict, cuts: list):
+    """The four whole bodies (FS, CS, bearing inner and outer ring); fills ``groups``.
+
+    ``cuts`` stays empty (no symmetry cut); same signature and return as ``_half_geometry``."""
+    fs_out, fs_fl = _fs_outline(geo, g, c, s)
+    fs_bore = _circle(geo, g.r_fs_bore, s["fs_bore"], c)
+    fs_surf = geo.addPlaneSurface([geo.addCurveLoop(fs_out), geo.addCurveLoop(fs_bore)])
+    groups["fs"] = (2, [fs_surf])
+    groups["fs_teeth"] = (1, fs_out)
+    groups["fs_bore"] = (1, fs_bore)
+    cs_in, cs_fl = _cs_outline(geo, g, c, s)
+    cs_outer = _circle(geo, g.r_cs_outer, s["cs_outer"], c)
+    cs_surf = geo.addPlaneSurface([geo.addCurveLoop(cs_outer), geo.addCurveLoop(cs_in)])
+    groups["cs"] = (2, [cs_surf])
+    groups["cs_teeth"] = (1, cs_in)
+    groups["cs_outer"] = (1, cs_outer)
+    ir_bore = _circle(geo, g.ir_bore, s["ring"], c)
+    ir_race = _circle(geo, g.ir_race, s["ring"], c)
+    ir_surf = geo.addPlaneSurface([geo.addCurveLoop(ir_race), geo.addCurveLoop(ir_bore)])
+    or_race = _circle(geo, g.or_race, s["ring"], c)
+    or_outer = _circle(geo, g.or_outer, s["ring"], c)
+    or_surf = geo.addPlaneSurface([geo.addCurveLoop(or_outer), geo.addCurveLoop(or_race)])
+    groups.update({"ir": (2, [ir_surf]), "ir_bore": (1, ir_bore), "ir_race": (1, ir_race),
+                   "or": (2, [or_surf]), "or_race": (1, or_race), "or_outer": (1, or_outer)})
+    return fs_fl, cs_fl, fs_bore, ir_bore, ir_race, or_race, or_outer, cs_outer
 
 
 def _half_geometry(geo, g: DriveGeometry, c: int, s: dict, groups: dict, cuts: list):

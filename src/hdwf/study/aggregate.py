@@ -17,7 +17,6 @@ import pyarrow as pa
 
 from hdwf import PARAMETER_COLUMNS
 from hdwf.common.io import write_parquet
-from hdwf.study.paper import load_fea_designs
 
 CORE_COLUMNS = ["design_id", *PARAMETER_COLUMNS, "phi_plus_arcmin", "phi_minus_arcmin",
                 "lost_motion_arcmin", "status"]

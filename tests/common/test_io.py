@@ -6,7 +6,7 @@ import pytest
 
 from hdwf.stages.paper import paper_lost_motion_stage
 from hdwf.study.aggregate import write_lost_motion
-from hdwf.config import config_hash
+from hdwf.common.provenance import config_hash
 from hdwf.common.io import atomic_path, read_parquet_meta
 from hdwf.common.provenance import provenance
 

@@ -1,20 +1,13 @@
 """Geometry of the two drives: cam of Eq. 3, involute flanks with normal offsets, mesh."""
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.integrate import quad
 
-try:
-    import hdwf  # noqa: F401
-except ImportError:  # package not installed: use the source tree
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
-
-from hdwf.drive.geometry import (ARCMIN, cam_radius, cs_half_space_angle, drive_geometry,
-                           fs_half_angle, geometric_backlash_arcmin, nominal_geometry)
+from hdwf.drive.geometry import (ARCMIN, cam_radius, cs_half_space_angle, drive_geometry, fs_half_angle,
+                                 geometric_backlash_arcmin, nominal_geometry)
 
 
 @pytest.mark.parametrize("unit", ["hd42", "hd120"])
@@ -101,6 +94,7 @@ def test_zero_offset_is_zero_backlash_and_backlash_formula():
     assert expect == pytest.approx(6.719, abs=0.002)
 
 
+@pytest.mark.slow
 def test_mesh_groups_and_density(tmp_path):
     """Coarse mesh: all 240 / 242 teeth present, named groups, .msh written; each flank
     carries elements_over_height segments."""

@@ -1,10 +1,9 @@
 """Sobol' indices: exact values of known decompositions, numerical integration, SALib estimates."""
 
 import numpy as np
-import pandas as pd
 import pytest
 
-from hdwf import PARAMETER_COLUMNS, PARAMETERS
+from hdwf import PARAMETER_COLUMNS
 from hdwf.study.paper import load_fea_designs, load_published
 from hdwf.study.sobol import convergence, estimate_indices, exact_indices, exact_quadratic_indices, radial_matrix
 from hdwf.study.surrogate import fit_quadratic
