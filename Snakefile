@@ -7,7 +7,11 @@
 
 from pathlib import Path
 
+from snakemake.utils import min_version
+
 from hdwf.config import validate_config
+
+min_version("9.0")
 
 configfile: "config.yaml"
 
@@ -22,6 +26,9 @@ include: "workflow/rules/fe.smk"
 include: "workflow/rules/stats.smk"
 include: "workflow/rules/validation.smk"
 include: "workflow/rules/report.smk"
+
+# Jobs too small to wait in a cluster queue: on Slurm they run on the submitting host.
+localrules: all, paper, fe_studies, validation, doe, fe_designs, paper_lost_motion, fe_aggregate, fe_convergence, correlation, surrogate, validation_figures, study_report, full_report
 
 
 rule all:
