@@ -1,12 +1,46 @@
 """Our FE model of the lost-motion test: a 2D plane-stress section of the drive solved with
 scikit-fem, with a contact solver written by hand (no maintained library solves frictional
 node-to-segment contact on scikit-fem's matrices).  See ``docs/fe-model.md``.
+
+The test: wave generator locked, CS held, the torque sequence 0 -> +T -> 0 -> -T -> 0 on
+the FS rim; the result is the torque-twist curve, phi (+T), phi' (-T) and the lost motion
+Phi = phi + phi'.  The modules, from the bottom up:
+
+* ``changes``: ``ModelChanges``, the physical additions to the baseline model;
+* ``hertz``: the Hertz law of a bearing ball;
+* ``bodies``: plane-stress stiffness, factorisation, rigid modes and half-model ties;
+* ``structure``: the bodies seen through the watch vector, the torque load and twist measure;
+* ``contact_geometry`` and ``contact_rows``: closest points and normals on the contact
+  surfaces, and the linearised gaps of cam, balls, fit and teeth;
+* ``working_set`` and ``friction``: the cached compliance of the working set, and the flank
+  law (frictionless or Coulomb) with its own cache and stick/slip state;
+* ``solver``: the active-set contact solver of one load level;
+* ``model``: ``LostMotionModel``, which assembles the pieces for one design;
+* ``cycle``: the test itself, ``solve_lost_motion`` and ``solve_lost_motion_variants``.
+
+Half model (``mesh.symmetry == "half"``, hand-written): the drive and its load are
+invariant under the rotation by pi about the axis (even tooth and ball counts, pi-periodic
+cam, torque), so the solution satisfies u(-x) = -u(x) and only the upper half of every
+body is meshed (``hdwf.drive.mesh``).  The cut is tied (``bodies``), contacts cover [0, pi)
+(``contact_rows``), the half rim carries T/2 (``structure``) and the tooth count is doubled
+(``cycle``).  Both models give the same Phi to mesh noise (two different gmsh meshes of one
+density).
+
+Approximations (known, small): P1 triangles (Phi of the designs we checked moves by
+< 2 % between 1x and 1.25x the paper's density, see docs/fe-model.md); the fit bins compare the
+two surfaces at equal reference angles (their relative slide of ~10 um on a surface slope
+<= 0.017 shifts those gaps by < 0.2 um, the same for every design); ball 0 sits on the
+major axis (one sample of the WG angle).  Friction, cup torsion, housing compliance,
+a temperature difference and Oldham play are off in the baseline (``ModelChanges``).
 """
 
-from hdwf.fe.model import (ContactFailure, LostMotionModel, LostMotionResult, ModelChanges,
-                           assemble_stiffness, ball_compliance_coeff, edge_loads, hertz_point_contact,
-                           plane_stress_lame, series_output_twist, solve_linear, solve_lost_motion,
+from hdwf.fe.bodies import assemble_stiffness, edge_loads, plane_stress_lame, solve_linear
+from hdwf.fe.changes import ModelChanges
+from hdwf.fe.cycle import (LostMotionResult, series_output_twist, solve_lost_motion,
                            solve_lost_motion_variants)
+from hdwf.fe.hertz import ball_compliance_coeff, hertz_point_contact
+from hdwf.fe.model import LostMotionModel
+from hdwf.fe.solver import ContactFailure
 
 __all__ = ["ContactFailure", "LostMotionModel", "LostMotionResult", "ModelChanges", "assemble_stiffness",
            "ball_compliance_coeff", "edge_loads", "hertz_point_contact", "plane_stress_lame",

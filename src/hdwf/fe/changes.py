@@ -1,0 +1,44 @@
+"""The physical additions to the baseline FE model, switched on one by one: ``ModelChanges``.
+
+The baseline has frictionless flanks, the CS clamped on its whole outer rim, FS and CS at one
+temperature and the output read on the FS rim; ``hdwf.validation.effects`` maps each candidate
+effect onto a field here, so every effect is a change of the model, never a correction of its
+output.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+
+@dataclass(frozen=True)
+class ModelChanges:
+    """Physical additions to the baseline model (frictionless flanks, CS clamped on its
+    whole outer rim, FS and CS at one temperature, output read on the FS rim).
+
+    ``hdwf.validation.effects`` maps each candidate effect's parameters onto these; every field is a
+    change to the FE model itself:
+
+    * ``flank_friction``: Coulomb coefficient on the FS-CS tooth contacts.  A sliding pair's
+      force becomes p (n + mu sigma t), sigma = -sign of its slip over the load step; a
+      sticking pair carries an unknown tangential force (|f_t| <= mu p) and does not slip.
+    * ``cs_rim_stiffness_N_mm2``: the CS outer rim held by radial and tangential springs
+      of this stiffness per mm of rim (an elastic housing) instead of clamped (inf).
+    * ``cs_scale``: the CS mesh scaled about the axis by this factor, i.e. a uniform
+      thermal strain of the CS relative to the FS and wave generator (1 = same
+      temperature; plane-stress stiffness is scale-invariant, only the fit changes).
+    * ``output_compliance_rad_per_Nmm``: a torsional spring in series between the FS rim
+      and the output where the twist is measured (the FS cup and diaphragm).
+    * ``output_play_rad``: a dead band in series in the output chain (e.g. the wave
+      generator's Oldham coupling, seen at the output).
+    """
+    flank_friction: float = 0.0
+    cs_rim_stiffness_N_mm2: float = math.inf
+    cs_scale: float = 1.0
+    output_compliance_rad_per_Nmm: float = 0.0
+    output_play_rad: float = 0.0
+
+    def fe_part(self) -> "ModelChanges":
+        """The changes that need a new contact solve: all but the series elements."""
+        return replace(self, output_compliance_rad_per_Nmm=0.0, output_play_rad=0.0)

@@ -1,0 +1,348 @@
+"""The lost-motion test on the FE model: mount the wave generator, run 0 -> +T -> 0 -> -T -> 0.
+
+Stage 1 pushes the wave generator into the FS (no teeth, FS rotation pinned); the cam rows
+are re-linearised at the deformed configuration until the geometry update is below 1e-6 mm.
+Stage 2 builds the tooth rows at the deflected configuration, frees the FS rotation and
+runs the torque sequence.  At +-T every tooth pair is re-detected at the deformed state
+(nonlinear gap); if that finds more than 0.05 um penetration (large twists slide the
+flanks), the pairs near contact are re-paired and re-linearised about that state and the
+level is solved again (``max_penetration_redetected_um`` reports the final check).
+
+The frictionless FS is indifferent inside the backlash at zero torque; zero-torque steps
+use 1e-3 of the test torque in the direction of the last load (the state an
+infinitesimally small friction would leave), documented in the result.  Curve twists are
+relative to the first (+0) state.  In the half model every tooth in contact has its image
+at +pi, so the count of teeth in contact is doubled.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+
+import numpy as np
+import scipy.sparse as sp
+
+from hdwf.drive.geometry import ARCMIN, DriveGeometry
+from hdwf.drive.mesh import DriveMesh
+from hdwf.fe.changes import ModelChanges
+from hdwf.fe.contact_rows import ball_rows, cam_rows, fit_rows, tooth_rows
+from hdwf.fe.model import LostMotionModel
+from hdwf.fe.solver import TOL_GAP, LevelSolution
+
+ZERO_TORQUE_BIAS = 1e-3  # fraction of the test torque used at the zero-torque steps
+RELIN_TOL = 5e-5         # mm: re-linearise tooth pairs at +-T above 0.05 um re-detected
+RELIN_NEAR = 5e-3        # mm: ... but only those pairs closer than this (the loaded flanks)
+
+
+@dataclass
+class LostMotionResult:
+    """The simulated test of one design: the torque-twist curve, Phi and how it was solved."""
+    phi_plus_arcmin: float
+    phi_minus_arcmin: float
+    lost_motion_arcmin: float
+    step: np.ndarray
+    torque_Nm: np.ndarray
+    twist_arcmin: np.ndarray
+    teeth_in_contact: int
+    max_penetration_um: float
+    iterations: int
+    status: str
+    reason: str
+    solve_s: float
+    factorize_s: float
+    n_dofs: int = 0
+    wg_deflection_um: float = float("nan")   # FS bore radial displacement at major axis
+    max_penetration_redetected_um: float = float("nan")  # tooth pairs re-found at +-T
+    notes: str = ""
+    fields: dict | None = None   # with keep_fields: {"wg": {...}, "plus": {...}} body -> (2, n) mm
+
+    @property
+    def curve(self) -> dict[str, np.ndarray]:
+        return {"step": self.step, "torque_Nm": self.torque_Nm,
+                "twist_arcmin": self.twist_arcmin}
+
+
+@dataclass(frozen=True)
+class _MountedWaveGenerator:
+    """Stage 1 solved: the contact solution and the FS bore's radial push at the major axis."""
+    solution: LevelSolution
+    deflection_um: float
+
+
+@dataclass(frozen=True)
+class _TorqueTest:
+    """Stage 2 solved: rim twists (rad) and the checks of the contact solution."""
+    twists: np.ndarray
+    max_penetration: float             # mm, over every level (balls excluded)
+    max_penetration_redetected: float  # mm, tooth pairs re-found at +-T
+    teeth_in_contact: int              # at +T
+    fields: dict | None                # displacement fields (keep_fields)
+
+
+def series_output_twist(rim_twist_rad: np.ndarray, torque_Nmm: np.ndarray,
+                        changes: ModelChanges) -> np.ndarray:
+    """Twist at the output from the twist of the FS rim along the test sequence.
+
+    The series spring adds T c, the dead band +-play/2 in the direction of the last
+    non-zero load (the zero-torque steps keep the side they were loaded from).
+
+    Parameters
+    ----------
+    rim_twist_rad : numpy.ndarray
+        Twist of the FS rim at every step (rad).
+    torque_Nmm : numpy.ndarray
+        Torque at every step (N mm).
+    changes : ModelChanges
+        ``output_compliance_rad_per_Nmm`` and ``output_play_rad`` are used.
+
+    Returns
+    -------
+    numpy.ndarray
+        Twist at the output at every step (rad).
+    """
+    out = np.asarray(rim_twist_rad, dtype=float) + changes.output_compliance_rad_per_Nmm * \
+        np.asarray(torque_Nmm, dtype=float)
+    if changes.output_play_rad:
+        side, last = np.zeros(len(out)), 1.0
+        for k, T in enumerate(torque_Nmm):
+            if abs(T) > 0:
+                last = math.copysign(1.0, T)
+            side[k] = last
+        out = out + 0.5 * changes.output_play_rad * side
+    return out
+
+
+def _load_path(steps_per_ramp: int) -> np.ndarray:
+    """Torque fractions 0 -> 1 -> 0 -> -1 -> 0 in ``steps_per_ramp`` steps per ramp."""
+    n = steps_per_ramp
+    up = np.linspace(0, 1, n + 1)
+    return np.concatenate([up, up[::-1][1:], -up[1:], -up[::-1][1:]])
+
+
+def _mount_wave_generator(model: LostMotionModel) -> _MountedWaveGenerator:
+    """Stage 1: the wave generator pushed into the FS (no teeth), FS rotation pinned."""
+    geom = model.geometry
+    # (the half model's symmetric field has no translations: no modes in stage 1)
+    model.mode_list = [] if model.half else [("fs", "tx"), ("fs", "ty"), ("ir", "tx"),
+                                             ("ir", "ty"), ("or", "tx"), ("or", "ty")]
+    model.rows["ball"] = ball_rows(model.structure, geom)
+    model.rows["fit"] = fit_rows(model.structure, geom, model.n_bins)
+    u = np.zeros(model.nwatch)
+    model.rows["cam"] = cam_rows(model.structure, geom, u)
+    state = None
+    for geo_it in range(6):
+        state = model.solve_level(0.0, state.active if state is not None else None)
+        u = state.u_watch
+        new = cam_rows(model.structure, geom, u)
+        change = np.max(np.abs((new.g0 + new.G @ u) - (model.rows["cam"].g0
+                                                        + model.rows["cam"].G @ u)))
+        if change < 1e-6 and geo_it > 0:
+            break
+        model.replace_rows("cam", new)
+    fs = model.bodies["fs"]
+    bore = fs.body_mesh.node_sets["fs_bore"]
+    j0 = bore[np.argmin((fs.x[0, bore] - geom.r_fs_bore) ** 2 + fs.x[1, bore] ** 2)]
+    return _MountedWaveGenerator(state, float(u[fs.watch_index[0, j0]]) * 1000.0)
+
+
+def _redetect_teeth(model: LostMotionModel, torque: float,
+                    level: LevelSolution) -> tuple[LevelSolution, float]:
+    """Independent check at +-T: re-detect every FS/CS pair in the zones at the deformed
+    configuration (nonlinear gap, no candidate threshold).  Large twists slide the flanks
+    along each other; if the linearised pairing then misses more than RELIN_TOL, re-pair
+    and re-linearise the tooth rows about this state and solve the level again.
+
+    Returns the final level and its re-detected penetration (mm)."""
+    geom = model.geometry
+    for relin in range(4):
+        chk = tooth_rows(model.structure, geom, level.u_watch, np.inf)
+        pen_nl = float(-(chk.g0 + chk.G @ level.u_watch).min())
+        if pen_nl <= RELIN_TOL or relin == 3:
+            break
+        tr = model.rows["tooth"]
+        new = tooth_rows(model.structure, geom, level.u_watch, np.inf, nodes=tr.slave_nodes)
+        # only pairs at or near contact are re-linearised; the open flanks
+        # keep the WG-state pairing, which is the right one for the way back
+        near = (tr.g0 + tr.G @ level.u_watch) < RELIN_NEAR
+        Dn = sp.diags(near.astype(float))
+        Df = sp.diags((~near).astype(float))
+        mixed = replace(tr, G=(Dn @ new.G + Df @ tr.G).tocsr(), g0=np.where(near, new.g0, tr.g0),
+                        slip=(Dn @ new.slip + Df @ tr.slip).tocsr())
+        model.replace_rows("tooth", mixed)
+        level = model.solve_level(torque, level.active)
+    return level, pen_nl
+
+
+def _teeth_in_contact(model: LostMotionModel, level: LevelSolution, kinds: np.ndarray) -> int:
+    """FS teeth with a loaded pair (both halves counted in the half model)."""
+    tr = model.rows["tooth"]
+    ti = [i for (kk, i) in level.pair_ids if kk == "tooth"]
+    pt = level.normal_force[kinds == "tooth"]
+    count = int(np.unique(tr.tooth[np.array(ti)[pt > 0]]).size)
+    if model.half:
+        count *= 2             # every tooth has its image at +pi
+    return count
+
+
+def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWaveGenerator,
+                 fields: dict | None) -> _TorqueTest:
+    """Stage 2: teeth at the deflected configuration, FS rotation free, the torque sequence."""
+    geom = model.geometry
+    Tn = geom.torque
+    cand = 0.25 * geom.module + 3 * (geom.r_fs + geom.r_cs)
+    model.rows["tooth"] = tooth_rows(model.structure, geom, mounted.solution.u_watch, cand)
+    model.mode_list = model.mode_list + [("fs", "rot")]
+    active = mounted.solution.active
+    twists, maxpen, maxpen_nl, tooth_count = [], 0.0, 0.0, 0
+    last_sign = 1.0
+    for fraction in frac:
+        if abs(fraction) > 1e-12:
+            last_sign = math.copysign(1.0, fraction)
+            T = fraction * Tn
+        else:
+            T = ZERO_TORQUE_BIAS * Tn * last_sign
+        level = model.solve_level(T, active)
+        if abs(abs(fraction) - 1.0) < 1e-12:
+            level, pen_nl = _redetect_teeth(model, T, level)
+            maxpen_nl = max(maxpen_nl, pen_nl)
+        active = level.active
+        twists.append(level.twist)
+        kinds = np.array([i[0] for i in level.pair_ids])
+        geo_mask = kinds != "ball"
+        maxpen = max(maxpen, float(-(level.gap[geo_mask]).min()))
+        if abs(fraction - 1.0) < 1e-12:
+            if fields is not None and "plus" not in fields:
+                fields["plus"] = model.full_displacements(level, T)
+            tooth_count = _teeth_in_contact(model, level, kinds)
+    return _TorqueTest(np.array(twists), maxpen, maxpen_nl, tooth_count, fields)
+
+
+def _result(model: LostMotionModel, changes: ModelChanges, frac: np.ndarray,
+            mounted: _MountedWaveGenerator, test: _TorqueTest, t0: float) -> LostMotionResult:
+    Tn = model.geometry.torque
+    tw = series_output_twist(test.twists, frac * Tn, changes) / ARCMIN
+    tw = tw - tw[0]
+    kp = int(np.argmin(np.abs(frac - 1.0)))
+    km = int(np.argmin(np.abs(frac + 1.0)))
+    phi_p, phi_m = float(tw[kp]), float(-tw[km])
+    maxpen_nl = test.max_penetration_redetected
+    return LostMotionResult(
+        phi_plus_arcmin=phi_p, phi_minus_arcmin=phi_m,
+        lost_motion_arcmin=phi_p + phi_m, step=np.arange(frac.size),
+        torque_Nm=frac * Tn / 1000.0, twist_arcmin=tw, teeth_in_contact=test.teeth_in_contact,
+        max_penetration_um=max(0.0, test.max_penetration) * 1000.0, iterations=model.iterations,
+        status="ok", reason="", solve_s=time.perf_counter() - t0,
+        factorize_s=model.factorize_s, n_dofs=model.n_dofs, wg_deflection_um=mounted.deflection_um,
+        max_penetration_redetected_um=max(0.0, maxpen_nl) * 1000.0,
+        notes=(f"zero-torque steps at {ZERO_TORQUE_BIAS:g} T_test towards the last load; "
+               f"tooth penetration re-detected at the deformed state at +-T: "
+               f"{max(0.0, maxpen_nl) * 1000:.4f} um"),
+        fields=test.fields)
+
+
+def _failed(exc: Exception, model: LostMotionModel | None, t0: float) -> LostMotionResult:
+    nan, empty = float("nan"), np.array([])
+    return LostMotionResult(
+        phi_plus_arcmin=nan, phi_minus_arcmin=nan, lost_motion_arcmin=nan,
+        step=empty, torque_Nm=empty, twist_arcmin=empty, teeth_in_contact=0,
+        max_penetration_um=nan, iterations=model.iterations if model is not None else 0,
+        status="failed", reason=f"{type(exc).__name__}: {exc}",
+        solve_s=time.perf_counter() - t0,
+        factorize_s=model.factorize_s if model is not None else nan,
+        n_dofs=model.n_dofs if model is not None else 0)
+
+
+def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int = 5,
+                      E: float | None = None, max_iter: int = 200,
+                      tol_gap: float = TOL_GAP, keep_fields: bool = False,
+                      changes: ModelChanges | None = None) -> LostMotionResult:
+    """Simulate the lost-motion test 0 -> +T -> 0 -> -T -> 0 (WG locked, CS fixed).
+
+    Parameters
+    ----------
+    geom : DriveGeometry
+        The design.
+    mesh : DriveMesh
+        Its mesh (full or half section).
+    steps_per_ramp : int
+        Load steps per ramp (4 ramps).
+    E : float, optional
+        Young's modulus instead of ``geom.E`` (e.g. the rigid-body limit).
+    max_iter : int
+        Active-set iterations per load level; a run that hits it returns status "failed".
+    tol_gap : float
+        Largest penetration accepted (mm).
+    keep_fields : bool
+        Also return the displacement of every node after the wave generator is mounted
+        (``wg``) and at +T (``plus``).
+    changes : ModelChanges, optional
+        Physical additions to the baseline model (set by ``hdwf.validation.effects``).
+
+    Returns
+    -------
+    LostMotionResult
+        Status "ok", or "failed" with a reason and no number.
+    """
+    changes = ModelChanges() if changes is None else changes
+    t0 = time.perf_counter()
+    frac = _load_path(steps_per_ramp)
+    model = None
+    try:
+        model = LostMotionModel(geom, mesh, E=E, max_iter=max_iter, tol_gap=tol_gap,
+                                changes=changes)
+        mounted = _mount_wave_generator(model)
+        fields = {"wg": model.full_displacements(mounted.solution, 0.0)} if keep_fields else None
+        test = _torque_test(model, frac, mounted, fields)
+        return _result(model, changes, frac, mounted, test, t0)
+    except Exception as exc:   # any failure is reported, never a silent number
+        return _failed(exc, model, t0)
+
+
+def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int,
+                               variants: list[ModelChanges]) -> list[LostMotionResult]:
+    """The test for several model variants of one design, sharing what they can.
+
+    The bodies are assembled and factorised and the wave generator mounted once; each
+    variant then switches its tooth-stage changes on a copy (a new CS factorisation only
+    when it changes the CS support) and runs the torque sequence.  Same numbers as
+    ``solve_lost_motion`` for each variant up to round-off.
+
+    Parameters
+    ----------
+    geom : DriveGeometry
+        The design.
+    mesh : DriveMesh
+        Its mesh.
+    steps_per_ramp : int
+        Load steps per ramp.
+    variants : list of ModelChanges
+        The model variants.
+
+    Returns
+    -------
+    list of LostMotionResult
+        One per variant, in order.
+    """
+    t0 = time.perf_counter()
+    frac = _load_path(steps_per_ramp)
+    base = None
+    try:
+        base = LostMotionModel(geom, mesh)
+        mounted = _mount_wave_generator(base)
+    except Exception as exc:
+        failed = _failed(exc, base, t0)
+        return [failed for _ in variants]
+    out = []
+    for ch in variants:
+        t1 = time.perf_counter()
+        model = None
+        try:
+            model = base.fork()
+            model.apply_tooth_stage_changes(ch.fe_part())
+            test = _torque_test(model, frac, mounted, None)
+            out.append(_result(model, ch, frac, mounted, test, t1))
+        except Exception as exc:
+            out.append(_failed(exc, model, t1))
+    return out

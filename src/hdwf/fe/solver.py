@@ -1,0 +1,314 @@
+"""The contact solver (hand-written): a dual Schur-complement / active-set method.
+
+Each body is factorised ONCE (scipy SuperLU, ``bodies``).  For a contact pair i the
+compliance column x_i = K^-1 G_i^T is obtained by back-substitution only when the pair
+first enters the working set, and reused over all later iterations and load steps
+(``working_set``).  On the working set the small dense mixed LCP
+
+    g = g0 + G K^-1 f + C p + H alpha >= 0,  p >= 0,  p.g = 0,  H^T p = -R^T f,
+    C = G K^-1 G^T + diag(s_ball),  H = G R
+
+is solved exactly by a primal-dual active-set (PDAS) iteration: solve the KKT system of
+the current active set, drop pairs with tensile p, add every candidate with penetration,
+repeat until no pair has p < 0 and the largest penetration of all candidate pairs is
+< ``tol_gap`` (1e-5 mm = 0.01 um).  Candidates outside the working set are checked every
+iteration with the displacement on the contact DOFs, so no violated pair can be missed.
+A free rigid mode that is loaded but not yet held (the FS rotation under torque while the
+teeth are apart) is closed by adding the first pair that closes along that mode.
+Around the PDAS, the Hertz secants s_ball of the balls are iterated to 0.1 % of the ball
+loads, and with flank friction the stick/slip states of the tooth pairs (``friction``).
+Cost: one factorisation per body plus back-solves, a handful of dense KKT solves per
+load step.  A level that does not converge raises ``ContactFailure``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+import scipy.sparse as sp
+
+from hdwf.fe.contact_rows import PairId, Rows, stack_rows
+from hdwf.fe.friction import (FRICTION_MAX_IT, ActiveBlock, FlankLaw, FrictionLevel,
+                              FrictionlessLevel)
+from hdwf.fe.structure import ModeName, RigidModes, Structure
+from hdwf.fe.working_set import WorkingSet
+
+TOL_GAP = 1e-5          # mm: 0.01 um allowed penetration
+
+Level = FrictionlessLevel | FrictionLevel
+
+
+class ContactFailure(RuntimeError):
+    """The contact problem of a load level did not converge."""
+
+
+@dataclass(frozen=True)
+class SolverSettings:
+    """Limits of the active-set iteration.
+
+    ``add_min`` and ``add_frac``: violated pairs added per iteration, the most violated
+    first (full switching cycles when a near-mechanism makes one iterate overshoot).
+    """
+    max_iter: int = 200          # active-set iterations per PDAS solve
+    tol_gap: float = TOL_GAP     # mm: largest penetration accepted
+    add_min: int = 5
+    add_frac: float = 0.2
+
+
+@dataclass(frozen=True)
+class LevelSolution:
+    """The contact solution at one torque; arrays are per pair of ``pair_ids``."""
+    normal_force: np.ndarray      # p (N)
+    tangential_force: np.ndarray  # friction force along the flank (N); zero without friction
+    mode_amplitude: np.ndarray    # alpha of the free rigid modes
+    u_watch: np.ndarray           # displacement on the watch vector (mm)
+    gap: np.ndarray               # g0 + G u (+ Hertz approach of the balls) (mm)
+    pair_ids: list[PairId]
+    twist: float                  # rim twist q^T u (rad)
+    active: frozenset[PairId]     # pairs in contact (warm start of the next level)
+
+
+@dataclass(frozen=True)
+class _LevelProblem:
+    """What every iteration of one level needs: the stacked rows and the free modes."""
+    structure: Structure
+    rows: dict[str, Rows]
+    torque: float
+    G: sp.csr_matrix
+    g0: np.ndarray
+    ids: list[PairId]
+    id_position: dict[PairId, int]
+    modes: RigidModes
+    mode_names: list[ModeName]
+    mode_gap_rates: np.ndarray    # GR = G R
+    ball_index: np.ndarray        # positions of the ball pairs in ``ids``
+    u_start: np.ndarray           # last level's displacement (or the free torque response)
+    free_gap: np.ndarray          # g0 + G u_start
+
+
+@dataclass(frozen=True)
+class _ActiveSetOutcome:
+    p: np.ndarray
+    ft: np.ndarray
+    alpha: np.ndarray
+    u: np.ndarray
+    gap: np.ndarray
+    converged: bool
+
+
+@dataclass
+class ContactSolver:
+    """The solver's state across load levels of one model.
+
+    ``last_u`` (the last level's displacement) and ``ball_loads`` (for the Hertz secants)
+    warm-start the next level; ``iterations`` counts active-set iterations.
+    """
+    settings: SolverSettings
+    ball_compliance: float                # c of delta = c P^(2/3) of one ball
+    working_set: WorkingSet
+    friction: FlankLaw
+    iterations: int = 0
+    last_u: np.ndarray | None = None
+    ball_loads: np.ndarray | None = None
+
+    def copy(self) -> "ContactSolver":
+        """An independent copy of the state (working set and friction cache copied)."""
+        return replace(self, working_set=self.working_set.copy(), friction=self.friction.copy())
+
+    def enter(self, structure: Structure, rows: dict[str, Rows], ids: list[PairId]):
+        """Enter pairs into the working set (and the friction cache)."""
+        added = self.working_set.add(structure, rows, ids)
+        if added is not None:
+            self.friction.pairs_added(structure, rows, added, self.working_set)
+
+    def refresh(self, structure: Structure, rows: dict[str, Rows], kind: str):
+        """Renew the cached columns of the working-set pairs of ``kind`` (new rows)."""
+        refreshed = self.working_set.refresh(structure, rows, kind)
+        if refreshed is not None:
+            self.friction.pairs_refreshed(structure, rows, refreshed, self.working_set)
+
+    # ---------------------------------------------------------------- one load level
+    def solve_level(self, structure: Structure, rows: dict[str, Rows], modes: list[ModeName],
+                    torque: float, active: frozenset[PairId] | None) -> LevelSolution:
+        """Solve the contact problem at one torque (N mm), warm-started from ``active``
+        (and the last displacement); Hertz secants of the balls iterated to 0.1 %, and the
+        stick/slip states of the flanks with friction.
+
+        Parameters
+        ----------
+        structure : Structure
+            The bodies and the watch vector.
+        rows : dict[str, Rows]
+            Every contact row, by kind.
+        modes : list of (body, mode)
+            The free rigid modes.
+        torque : float
+            Torque on the FS rim (N mm).
+        active : frozenset, optional
+            Pairs in contact at the start (the last level's ``active``).
+
+        Returns
+        -------
+        LevelSolution
+        """
+        problem = self._level_problem(structure, rows, modes, torque)
+        act = set() if active is None else set(active)
+        # initial: every violated pair at zero contact force
+        act |= {problem.ids[j] for j in np.flatnonzero(problem.free_gap < -self.settings.tol_gap)}
+        level = self.friction.start_level(rows, problem.ids, problem.modes.watch, problem.u_start,
+                                          structure.unit_torque_u_watch)
+        for _ in range(FRICTION_MAX_IT):
+            outcome, act = self._hertz_loop(problem, act, level)
+            if level.settle(outcome.p, outcome.ft, outcome.u):
+                break
+        else:
+            raise ContactFailure("flank friction: stick/slip states did not settle in "
+                                 f"{FRICTION_MAX_IT} iterations at T={torque / 1000:.4g} N m")
+        self.friction.finish_level(level)
+        self.last_u = outcome.u
+        return self._solution(problem, outcome, act, level)
+
+    def _level_problem(self, structure: Structure, rows: dict[str, Rows],
+                       modes: list[ModeName], torque: float) -> _LevelProblem:
+        stacked = stack_rows(rows)
+        G, g0, ids = stacked.G, stacked.g0, stacked.ids
+        rigid = structure.rigid_modes(modes)
+        u0 = torque * structure.unit_torque_u_watch if self.last_u is None else self.last_u
+        return _LevelProblem(
+            structure=structure, rows=rows, torque=torque, G=G, g0=g0, ids=ids,
+            id_position={i: j for j, i in enumerate(ids)}, modes=rigid, mode_names=modes,
+            mode_gap_rates=G @ rigid.watch,
+            ball_index=np.array([j for j, (k, _) in enumerate(ids) if k == "ball"]),
+            u_start=u0, free_gap=g0 + G @ u0)
+
+    def _solution(self, problem: _LevelProblem, outcome: _ActiveSetOutcome, act: set[PairId],
+                  level: Level) -> LevelSolution:
+        """The level's solution with its twist q^T u from the cached twist columns."""
+        ws, ids, idpos = self.working_set, problem.ids, problem.id_position
+        p_full, ft = outcome.p, outcome.ft
+        wp = np.array([ws.position[i] for i in ids if i in ws.position], dtype=np.int64)
+        pw = np.array([p_full[idpos[i]] for i in ids if i in ws.position])
+        twist = (problem.torque * problem.structure.unit_torque_twist
+                 + (ws.twist_columns[wp] @ pw if wp.size else 0.0) + problem.modes.twist @ outcome.alpha)
+        fw = np.array([ft[idpos[i]] for i in ids if i in ws.position])
+        twist = level.add_slip_twist(twist, wp, fw)
+        return LevelSolution(p_full, ft, outcome.alpha, outcome.u, outcome.gap, ids, float(twist),
+                             frozenset(act))
+
+    def _hertz_loop(self, problem: _LevelProblem, act: set[PairId],
+                    level: Level) -> tuple[_ActiveSetOutcome, set[PairId]]:
+        """PDAS solves with the Hertz secants of the balls updated to convergence."""
+        pb = self.ball_loads
+        if pb is None:
+            pb = np.full(problem.ball_index.size, 1.0)
+        for _ in range(40):
+            s_ball = self.ball_compliance * np.maximum(pb, 1e-3) ** (-1.0 / 3.0)
+            outcome = self._pdas(problem, act, s_ball, level)
+            act = {problem.ids[j] for j in np.flatnonzero(outcome.p > 0)}
+            pb_new = outcome.p[problem.ball_index]
+            on = pb_new > 0        # the secant of an open ball does not matter
+            change = (np.max(np.abs(pb_new - pb)[on]) if on.any() else 0.0) / max(
+                1e-9, np.max(np.abs(pb_new)))
+            pb = np.where(pb_new > 0, pb_new, pb)
+            if not outcome.converged:
+                raise ContactFailure(f"active-set iteration did not converge in "
+                                     f"{self.settings.max_iter} iterations at "
+                                     f"T={problem.torque / 1000:.4g} N m")
+            if change < 1e-3:
+                break
+        else:
+            raise ContactFailure("Hertz secant iteration on ball loads did not converge")
+        self.ball_loads = pb
+        return outcome, act
+
+    # ---------------------------------------------------------------- PDAS
+    def _pdas(self, problem: _LevelProblem, act: set[PairId], s_ball: np.ndarray,
+              level: Level) -> _ActiveSetOutcome:
+        """Primal-dual active set on the dense dual problem; see the module docstring."""
+        ids = problem.ids
+        sdiag = np.zeros(len(ids))
+        sdiag[problem.ball_index] = s_ball
+        Guq = problem.G @ problem.structure.unit_torque_u_watch
+        A = set(act)
+        for it in range(self.settings.max_iter):
+            self.iterations += 1
+            self.enter(problem.structure, problem.rows, sorted(A - set(self.working_set.position)))
+            self._hold_loaded_modes(problem, A)
+            block = self._active_block(problem, A, sdiag, Guq)
+            pA, p_full, ft_full, alpha, u = self._solve_block(problem, block, level)
+            gap = problem.g0 + problem.G @ u + sdiag * p_full
+            neg = [block.pairs[k] for k in np.flatnonzero(pA < 0)]
+            viol = np.flatnonzero(gap < -self.settings.tol_gap)
+            viol = viol[np.argsort(gap[viol])]
+            viol = [ids[j] for j in viol if ids[j] not in A]
+            # limited addition: the most violated few first (full switching cycles when
+            # a near-mechanism makes one iterate overshoot)
+            viol = viol[:max(self.settings.add_min, int(self.settings.add_frac * len(viol)))]
+            if not neg and not viol:
+                return _ActiveSetOutcome(np.maximum(p_full, 0.0), ft_full, alpha, u, gap, True)
+            if it > 25 and neg:          # anti-cycling: one change at a time
+                neg = [block.pairs[int(np.argmin(pA))]]
+            A.difference_update(neg)
+            A.update(viol)
+        return _ActiveSetOutcome(p_full, ft_full, alpha, u, gap, False)
+
+    def _hold_loaded_modes(self, problem: _LevelProblem, A: set[PairId]):
+        """A loaded rigid mode with nothing holding it: add the first pair it closes."""
+        position = self.working_set.position
+        rows = [problem.id_position[i] for i in sorted(A, key=lambda i: position[i])]
+        GR, load_per_torque = problem.mode_gap_rates, problem.modes.load
+        for j in range(GR.shape[1]):
+            load = problem.torque * load_per_torque[j]
+            if abs(load) < 1e-12:
+                continue
+            held = np.abs(GR[rows, j]).max() if rows else 0.0
+            if held > 1e-12:
+                continue
+            rate = GR[:, j] * np.sign(load)
+            closing = np.flatnonzero(rate < -1e-12)
+            if closing.size == 0:
+                raise ContactFailure(f"rigid mode {problem.mode_names[j]} is loaded but no "
+                                     "contact pair can hold it")
+            need = problem.free_gap[closing] / (-rate[closing])
+            jbest = closing[np.argmin(need)]
+            A.add(problem.ids[jbest])
+            self.enter(problem.structure, problem.rows, [problem.ids[jbest]])
+
+    def _active_block(self, problem: _LevelProblem, A: set[PairId], sdiag: np.ndarray,
+                      Guq: np.ndarray) -> ActiveBlock:
+        """The blocks of the dual system on the active set A (``sdiag``: ball secants,
+        ``Guq``: G K^-1 f per unit torque)."""
+        ws = self.working_set
+        Al = sorted(A, key=lambda i: ws.position[i])
+        wp = np.array([ws.position[i] for i in Al], dtype=np.int64)
+        rows = np.array([problem.id_position[i] for i in Al], dtype=np.int64)
+        C = ws.compliance[np.ix_(wp, wp)]
+        C = 0.5 * (C + C.T) + np.diag(sdiag[rows])
+        T = problem.torque
+        return ActiveBlock(
+            torque=T, pairs=Al, positions=wp, rows=rows, compliance=C,
+            mode_rows=problem.mode_gap_rates[rows],
+            scale=np.abs(np.diag(C)).max() if len(Al) else 1.0,
+            gap_rhs=-(problem.g0[rows] + T * Guq[rows]), mode_rhs=-T * problem.modes.load,
+            n_pairs=len(problem.ids))
+
+    def _solve_block(self, problem: _LevelProblem, block: ActiveBlock, level: Level):
+        """Solve the KKT system of an active set: (p_A, p, f_t, alpha, u_watch)."""
+        system = level.kkt(block)
+        nA, nS, nm = len(block.pairs), system.n_tangential, block.mode_rows.shape[1]
+        M = system.matrix
+        M[nA + nS:, nA + nS:] = -1e-14 * np.eye(nm)   # keeps unheld, unloaded modes at zero
+        try:
+            sol = np.linalg.solve(M, system.rhs)
+        except np.linalg.LinAlgError:
+            sol = np.linalg.lstsq(M, system.rhs, rcond=None)[0]
+        pA, alpha = sol[:nA], sol[nA + nS:]
+        pW = np.zeros(len(self.working_set.pairs))
+        pW[block.positions] = pA
+        u = (problem.torque * problem.structure.unit_torque_u_watch + self.working_set.columns @ pW
+             + problem.modes.watch @ alpha)
+        u, ft_full = level.tangential(system, sol, block, u)
+        p_full = np.zeros(block.n_pairs)
+        p_full[block.rows] = pA
+        return pA, p_full, ft_full, alpha, u

@@ -1,0 +1,132 @@
+"""The working set of the contact solver: the pairs whose compliance is known, and that compliance.
+
+For a contact pair i the compliance column x_i = K^-1 G_i^T is obtained by back-substitution
+only when the pair first enters the working set, and reused over all later iterations and
+load steps; the working set also keeps the compliance among its pairs, C_ij = G_i K^-1 G_j^T,
+grown by the new columns, and the twist of every column, q^T x_i.  A pair never leaves the
+working set; only its linearisation can be renewed (``refresh``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from hdwf.fe.contact_rows import PairId, Rows
+from hdwf.fe.structure import Structure
+
+
+def grow_column_store(buf: np.ndarray, n0: int, k: int) -> np.ndarray:
+    """``buf`` with room for ``k`` more columns after its first ``n0`` (grown geometrically).
+
+    Parameters
+    ----------
+    buf : numpy.ndarray
+        (nwatch, capacity) column store; its first ``n0`` columns are in use.
+    n0, k : int
+        Columns in use and columns to add.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``buf`` itself if it has room, else a larger copy.
+    """
+    if n0 + k <= buf.shape[1]:
+        return buf
+    cap = max(2 * buf.shape[1], n0 + k, 256)
+    new = np.zeros((buf.shape[0], cap))
+    new[:, :n0] = buf[:, :n0]
+    return new
+
+
+@dataclass(frozen=True)
+class AddedPairs:
+    """Pairs that just entered the working set."""
+    ids: list[PairId]
+    normal_rows: sp.csr_matrix    # their rows G
+    first: int                    # working-set position of the first of them
+
+
+@dataclass(frozen=True)
+class RefreshedPairs:
+    """Working-set pairs of one kind whose rows were renewed."""
+    kind: str
+    positions: np.ndarray         # their working-set positions
+    row_indices: list[int]        # their row indices in the rows of that kind
+
+
+class WorkingSet:
+    """Working-set pairs with their cached compliance columns (see the module docstring).
+
+    Parameters
+    ----------
+    nwatch : int
+        Length of the watch vector.
+    """
+
+    def __init__(self, nwatch: int):
+        self.pairs: list[PairId] = []
+        self.position: dict[PairId, int] = {}
+        self._column_store = np.zeros((nwatch, 0))  # K^-1 G^T on the watch dofs, by position
+        self.twist_columns = np.zeros(0)            # q^T K^-1 G^T
+        self.normal_rows: sp.csr_matrix | None = None   # G of the pairs, by position
+        self.compliance = np.zeros((0, 0))          # G K^-1 G^T among the pairs
+
+    def copy(self) -> "WorkingSet":
+        """An independent copy (the rows matrix is never changed in place, so it is shared)."""
+        new = WorkingSet(0)
+        new.pairs, new.position = list(self.pairs), dict(self.position)
+        new._column_store = self._column_store.copy()
+        new.twist_columns = self.twist_columns.copy()
+        new.normal_rows = self.normal_rows
+        new.compliance = self.compliance.copy()
+        return new
+
+    @property
+    def columns(self) -> np.ndarray:
+        """Compliance columns K^-1 G^T (nwatch x pairs) of the working set."""
+        return self._column_store[:, :len(self.pairs)]
+
+    def add(self, structure: Structure, rows: dict[str, Rows],
+            ids: list[PairId]) -> AddedPairs | None:
+        """Enter the pairs ``ids`` not yet in the working set; None if there are none."""
+        ids = [i for i in ids if i not in self.position]
+        if not ids:
+            return None
+        Gn = sp.vstack([rows[k].G[i] for k, i in ids]).tocsr()
+        X, Xq = structure.compliance_columns(Gn)
+        n0, k = len(self.pairs), len(ids)
+        self._column_store = grow_column_store(self._column_store, n0, k)
+        self._column_store[:, n0:n0 + k] = X
+        for i in ids:
+            self.position[i] = len(self.pairs)
+            self.pairs.append(i)
+        self.twist_columns = np.concatenate([self.twist_columns, Xq])
+        # compliance among the working set, grown by the new columns
+        self.normal_rows = Gn if self.normal_rows is None else sp.vstack([self.normal_rows,
+                                                                          Gn]).tocsr()
+        newcols = np.asarray(self.normal_rows @ X)
+        CW = np.zeros((n0 + k, n0 + k))
+        CW[:n0, :n0] = self.compliance
+        CW[:, n0:] = newcols
+        CW[n0:, :n0] = newcols[:n0].T
+        self.compliance = CW
+        return AddedPairs(ids, Gn, n0)
+
+    def refresh(self, structure: Structure, rows: dict[str, Rows],
+                kind: str) -> RefreshedPairs | None:
+        """Renew the columns of the pairs of ``kind`` after a new linearisation of its rows
+        (same count); None if none of them is in the working set."""
+        idx = [(self.position[(k, i)], i) for (k, i) in self.pairs if k == kind]
+        if not idx:
+            return None
+        pos = np.array([a for a, _ in idx])
+        row_indices = [b for _, b in idx]
+        X, Xq = structure.compliance_columns(rows[kind].G[row_indices])
+        self._column_store[:, pos] = X
+        self.twist_columns[pos] = Xq
+        self.normal_rows = sp.vstack([rows[k].G[i] for k, i in self.pairs]).tocsr()
+        self.compliance = np.asarray(self.normal_rows @ self.columns)
+        return RefreshedPairs(kind, pos, row_indices)
