@@ -1,7 +1,9 @@
-# The study's PDF report, typeset with typst from the artefacts only.
+# The PDF reports, typeset with typst from the artefacts only (hdwf.stages.report, hdwf.report).
+# Each report rule has one named input per kind of artefact, a list of paths, and the parameter
+# `owners`: the same names with, per path, whose artefact it is ([study, unit] or [campaign]).
 
-# Per-drive artefacts the report reads, keyed as hdwf.report.document expects them ("<unit>__<key>").
-REPORT_ARTEFACTS = {
+# What the reports read of each drive of a study: kind -> file under results/{study}/{unit}/.
+DRIVE_ARTEFACTS = {
     "lost_motion": "lost_motion.parquet",
     "correlation": "correlation.parquet",
     "correlation_png": "correlation.png",
@@ -10,25 +12,64 @@ REPORT_ARTEFACTS = {
     "sobol": "sobol.parquet",
     "sobol_png": "sobol_convergence.png",
 }
+# What the full report reads of each campaign: kind -> file under results/validation/{campaign}/.
+CAMPAIGN_ARTEFACTS = {
+    "diagnosis": "diagnosis.json",
+    "ladder": "ladder.parquet",
+    "measured_png": "measured_vs_predicted.png",
+    "residuals_png": "residuals.png",
+    "ladder_png": "ladder.png",
+}
 
 
-def report_inputs(wildcards):
-    units = study_units(wildcards.study)
-    files = {}
-    for unit in units:
-        for key, name in REPORT_ARTEFACTS.items():
-            files[f"{unit}__{key}"] = f"results/{wildcards.study}/{unit}/{name}"
-        files[f"{unit}__doe"] = f"results/doe/{unit}/designs.parquet"
-    return files
+def study_entries(study, fe_parts):
+    """(kind, owner, path) of each artefact of the study; with `fe_parts` also what Part II shows."""
+    for unit in study_units(study):
+        owner = [study, unit]
+        for kind, name in DRIVE_ARTEFACTS.items():
+            yield kind, owner, f"results/{study}/{unit}/{name}"
+        yield "doe", owner, f"results/doe/{unit}/designs.parquet"
+        if not fe_parts:
+            continue
+        if STUDIES[study]["source"] == "fe":
+            yield "curves", owner, f"results/{study}/{unit}/curves.parquet"
+        if study == FE["convergence"]["study"]:
+            yield "convergence", owner, f"results/{study}/{unit}/convergence.parquet"
+        if study == FE["picture"]["study"]:
+            yield "deformed_png", owner, f"results/{study}/{unit}/deformed_{FE['picture']['design']}.png"
+
+
+def campaign_entries(campaign):
+    for kind, name in CAMPAIGN_ARTEFACTS.items():
+        yield kind, [campaign], f"results/validation/{campaign}/{name}"
+
+
+def named_inputs(entries):
+    """Entries -> the named inputs (kind -> paths) and the owners (kind -> owner per path)."""
+    files, owners = {}, {}
+    for kind, owner, path in entries:
+        files.setdefault(kind, []).append(path)
+        owners.setdefault(kind, []).append(owner)
+    return files, owners
+
+
+def study_report_files(wildcards):
+    return named_inputs(study_entries(wildcards.study, fe_parts=False))
+
+
+def full_report_files():
+    entries = [e for study in STUDIES for e in study_entries(study, fe_parts=True)]
+    entries += [e for campaign in CAMPAIGNS for e in campaign_entries(campaign)]
+    return named_inputs(entries)
 
 
 rule study_report:
     input:
-        unpack(report_inputs),
+        unpack(lambda w: study_report_files(w)[0]),
     output:
         "results/{study}/report.pdf",
     params:
-        units=lambda w: study_units(w.study),
+        owners=lambda w: study_report_files(w)[1],
         study_config=lambda w: STUDIES[w.study],
         data_dir=config["paper_data"],
         repo=REPO_DIR,
@@ -38,38 +79,15 @@ rule study_report:
         "../scripts/report.py"
 
 
-def full_report_inputs(wildcards):
-    files = {}
-    for study in STUDIES:
-        for unit in study_units(study):
-            for key, name in REPORT_ARTEFACTS.items():
-                files[f"{study}__{unit}__{key}"] = f"results/{study}/{unit}/{name}"
-            files[f"{study}__{unit}__doe"] = f"results/doe/{unit}/designs.parquet"
-            if STUDIES[study]["source"] == "fe":
-                files[f"{study}__{unit}__curves"] = f"results/{study}/{unit}/curves.parquet"
-            if study == FE["convergence"]["study"]:
-                files[f"{study}__{unit}__convergence"] = f"results/{study}/{unit}/convergence.parquet"
-            if study == FE["picture"]["study"]:
-                files[f"{study}__{unit}__deformed_png"] = f"results/{study}/{unit}/deformed_{FE['picture']['design']}.png"
-    for c in CAMPAIGNS:
-        base = f"results/validation/{c}"
-        files.update({f"validation__{c}__diagnosis": f"{base}/diagnosis.json",
-                      f"validation__{c}__ladder": f"{base}/ladder.parquet",
-                      f"validation__{c}__measured_png": f"{base}/measured_vs_predicted.png",
-                      f"validation__{c}__residuals_png": f"{base}/residuals.png",
-                      f"validation__{c}__ladder_png": f"{base}/ladder.png"})
-    return files
-
-
 rule full_report:
     input:
-        unpack(full_report_inputs),
+        unpack(lambda w: full_report_files()[0]),
     output:
         "results/report.pdf",
     params:
+        owners=lambda w: full_report_files()[1],
         studies=STUDIES,
         fe_settings={k: v for k, v in FE.items() if k not in ("convergence", "picture")},
-        campaigns=list(CAMPAIGNS),
         data_dir=config["paper_data"],
         repo=REPO_DIR,
     log:

@@ -1,12 +1,15 @@
-"""Adapter for rule study_report: the study's artefacts -> report.pdf (hdwf.report.document)."""
-import sys
-sys.path.insert(0, __import__("os").path.dirname(__file__))
-from _adapter import setup  # noqa: E402
+"""Rule study_report: a study's artefacts -> results/{study}/report.pdf."""
+import logging
 
-from hdwf.report.document import study_report  # noqa: E402
+from _helpers import mock_snakemake, setup
 
-prov = setup(snakemake)  # noqa: F821
-study_report(study=snakemake.wildcards.study, units=snakemake.params.units,  # noqa: F821
-             files=dict(snakemake.input.items()), data_dir=snakemake.params.data_dir,  # noqa: F821
-             study_config=dict(snakemake.params.study_config), provenance=prov,  # noqa: F821
-             out=snakemake.output[0])  # noqa: F821
+from hdwf.stages.report import study_report_stage
+
+if "snakemake" not in globals():  # run by hand, e.g. to debug one step (see _helpers.mock_snakemake)
+    snakemake = mock_snakemake("study_report", study="paper")
+
+prov = setup(snakemake)
+p = snakemake.params
+pdf = study_report_stage(snakemake.wildcards.study, p.study_config, dict(snakemake.input.items()), p.owners,
+                         p.data_dir, prov, snakemake.output[0])
+logging.info("wrote %s", pdf)

@@ -1,19 +1,22 @@
-"""Figures of the study, in the paper's forms (Figs. 6–9, 13–14), written atomically as PNG."""
+"""Figures of the study, in the paper's forms (Figs. 6–9, 13–14), of the FE model (curves, agreement,
+deformed mesh) and of the validation campaigns, each written atomically as a PNG file."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+from matplotlib.collections import PolyCollection
+from scipy.optimize import isotonic_regression
 
+from hdwf import PARAMETER_COLUMNS, PARAMETER_LABELS, PARAMETERS
+from hdwf.common.io import atomic_path
+
+# Files only, never a window: the same backend on every machine, whatever MPLBACKEND says.
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-from scipy.optimize import isotonic_regression  # noqa: E402
-
-from hdwf import PARAMETER_COLUMNS, PARAMETER_LABELS, PARAMETERS  # noqa: E402
-from hdwf.common.io import atomic_path  # noqa: E402
 
 _PNG_META = {"Software": None}  # no version string in the file: same data, same bytes
 
@@ -29,7 +32,17 @@ def _label(p):
 
 
 def correlation_figure(designs: pd.DataFrame, corr: pd.DataFrame, title: str, path) -> None:
-    """Φ against each input with the Pearson line and a monotone (rank) trend, as Figs. 6/7."""
+    """Φ against each input with the Pearson line and a monotone (rank) trend, as Figs. 6/7.
+
+    Parameters
+    ----------
+    designs
+        The study's lost-motion table (inputs and ``lost_motion_arcmin``).
+    corr
+        Its correlation table (``pearson_r``, ``spearman_rho`` per parameter).
+    title, path
+        The figure's title and PNG file.
+    """
     y = designs["lost_motion_arcmin"].to_numpy(float)
     fig, axes = plt.subplots(1, 5, figsize=(15, 3.2), sharey=True)
     for ax, p, col in zip(axes, PARAMETERS, PARAMETER_COLUMNS):
@@ -56,7 +69,17 @@ def correlation_figure(designs: pd.DataFrame, corr: pd.DataFrame, title: str, pa
 
 
 def surrogate_figure(designs: pd.DataFrame, fitted: np.ndarray, title: str, path) -> None:
-    """Data (circles) and surrogate (asterisks) against each input, as Figs. 8/9, plus a parity plot."""
+    """Data (circles) and surrogate (asterisks) against each input, as Figs. 8/9, plus a parity plot.
+
+    Parameters
+    ----------
+    designs
+        The designs the surrogate was fitted to.
+    fitted
+        The surrogate's values at those designs.
+    title, path
+        The figure's title and PNG file.
+    """
     y = designs["lost_motion_arcmin"].to_numpy(float)
     fig, axes = plt.subplots(1, 6, figsize=(17, 3.2))
     for ax, p, col in zip(axes, PARAMETERS, PARAMETER_COLUMNS):
@@ -80,7 +103,15 @@ def surrogate_figure(designs: pd.DataFrame, fitted: np.ndarray, title: str, path
 
 
 def sobol_convergence_figure(sobol: pd.DataFrame, title: str, path) -> None:
-    """S1 (left) and ST (right) against N for each sampler, exact values dashed, as Figs. 13/14."""
+    """S1 (left) and ST (right) against N for each sampler, exact values as thick lines, as Figs. 13/14.
+
+    Parameters
+    ----------
+    sobol
+        The study's Sobol' table (exact values and each sampler's estimates by N).
+    title, path
+        The figure's title and PNG file.
+    """
     exact = sobol[sobol["sampler"] == "exact"].set_index("parameter")
     est = sobol[sobol["sampler"] != "exact"]
     styles = {"lhs": ":", "halton": "--", "sobol": "-"}
@@ -104,7 +135,19 @@ def sobol_convergence_figure(sobol: pd.DataFrame, title: str, path) -> None:
 
 
 def curves_figure(curves: pd.DataFrame, lost_motion: pd.DataFrame, design_ids: list[str], title: str, path) -> None:
-    """Torque–twist curves of a few designs (the paper's Fig. 1 measured in our model)."""
+    """Torque–twist curves of a few designs (the paper's Fig. 1 measured in our model).
+
+    Parameters
+    ----------
+    curves
+        The study's torque–twist curves (``curves.parquet``).
+    lost_motion
+        Its lost-motion table, for the legend.
+    design_ids
+        The designs drawn.
+    title, path
+        The figure's title and PNG file.
+    """
     fig, ax = plt.subplots(figsize=(6.5, 4))
     lm = lost_motion.set_index("design_id")
     for did in design_ids:
@@ -122,7 +165,15 @@ def curves_figure(curves: pd.DataFrame, lost_motion: pd.DataFrame, design_ids: l
 
 
 def agreement_figure(pairs: dict[str, tuple[np.ndarray, np.ndarray]], title: str, path) -> None:
-    """Our Φ against the paper's Φ at the same design points, one panel per drive."""
+    """Our Φ against the paper's Φ at the same design points, one panel per drive.
+
+    Parameters
+    ----------
+    pairs
+        Panel title -> (the paper's Φ, ours) at the same designs.
+    title, path
+        The figure's title and PNG file.
+    """
     fig, axes = plt.subplots(1, len(pairs), figsize=(5.2 * len(pairs), 4.2), squeeze=False)
     for ax, (label, (paper, ours)) in zip(axes[0], pairs.items()):
         ok = np.isfinite(ours)
@@ -152,9 +203,22 @@ def deformed_figure(mesh, fields: dict, title: str, path, half_width_mm: float, 
     Colour: deformation added by the test torque (u at +T minus u after mounting the wave
     generator, each body's rigid rotation removed), in µm — where the load goes. Bearing
     rings are drawn grey.
-    """
-    from matplotlib.collections import PolyCollection
 
+    Parameters
+    ----------
+    mesh
+        The drive's mesh (``hdwf.drive.design``), half or full.
+    fields
+        Displacements per state (``plus``, ``wg``) and body.
+    title, path
+        The figure's title and PNG file.
+    half_width_mm
+        Half the height of the window about the major axis.
+    xlim
+        The radial window (mm).
+    magnify
+        Scale of the displacements drawn.
+    """
     fig, ax = plt.subplots(figsize=(8, 5.5))
     plus, wg = fields["plus"], fields["wg"]
     values, polys = [], []
@@ -187,10 +251,16 @@ def deformed_figure(mesh, fields: dict, title: str, path, half_width_mm: float, 
     _save(fig, path)
 
 
-# ------------------------------------------------------------------ model against measurements
-
 def measured_vs_predicted_figure(points: pd.DataFrame, title: str, path) -> None:
-    """Measured against predicted, before (campaign model) and after (found effects on)."""
+    """Measured against predicted, before (campaign model) and after (found effects on).
+
+    Parameters
+    ----------
+    points
+        The campaign's points: measured ``D``, predicted ``S_model`` and ``S_final``.
+    title, path
+        The figure's title and PNG file.
+    """
     fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), sharex=True, sharey=True)
     D = points["D"].to_numpy(float)
     every = np.concatenate([D, points["S_model"].to_numpy(float), points["S_final"].to_numpy(float)])
@@ -210,7 +280,16 @@ def measured_vs_predicted_figure(points: pd.DataFrame, title: str, path) -> None
 
 def residual_figure(points: pd.DataFrame, title: str, path) -> None:
     """Residual D − S of the campaign model against each input (specimen means) and, for
-    curves, along the test by torque and branch; the found effects' residual beside it."""
+    curves, along the test by torque and branch; the found effects' residual beside it.
+
+    Parameters
+    ----------
+    points
+        The campaign's points (``D``, ``S_model``, ``S_final``, inputs, and for curves
+        ``torque_Nm`` and ``branch``).
+    title, path
+        The figure's title and PNG file.
+    """
     curve = "torque_Nm" in points.columns and points["torque_Nm"].notna().any()
     ncol = len(PARAMETERS) + (1 if curve else 0)
     fig, axes = plt.subplots(1, ncol, figsize=(3 * ncol, 3.2), sharey=True)
@@ -239,7 +318,17 @@ def residual_figure(points: pd.DataFrame, title: str, path) -> None:
 
 
 def ladder_figure(ladder: pd.DataFrame, noise_arcmin: float | None, title: str, path) -> None:
-    """RMSE of each model variant of the ladder, falling rung by rung."""
+    """RMSE of each model variant of the ladder, falling rung by rung.
+
+    Parameters
+    ----------
+    ladder
+        The campaign's ladder (``model``, ``rmse_arcmin`` per rung).
+    noise_arcmin
+        The stated measurement noise, drawn as a line; none when ``None``.
+    title, path
+        The figure's title and PNG file.
+    """
     fig, ax = plt.subplots(figsize=(6.5, 3.6))
     x = np.arange(len(ladder))
     ax.plot(x, ladder["rmse_arcmin"], "o-", color="tab:blue", label="RMSE (actual solves)")

@@ -1,0 +1,98 @@
+"""What the report reads: the paths of each study's per-drive artefacts and of each validation
+campaign's, and the settings it quotes, as typed records. Paths only: the parts of the report
+open the files themselves."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from hdwf.drive.design import MeshSettings
+
+
+@dataclass(frozen=True)
+class DriveArtefacts:
+    """One drive's artefacts in one study (``results/{study}/{unit}/``).
+
+    ``curves`` exist for FE studies, ``convergence`` for the mesh-convergence study and
+    ``deformed_png`` for the study whose deformed mesh is pictured; ``None`` elsewhere.
+    """
+
+    unit: str
+    lost_motion: Path
+    doe: Path
+    correlation: Path
+    correlation_png: Path
+    surrogate: Path
+    surrogate_png: Path
+    sobol: Path
+    sobol_png: Path
+    curves: Path | None = None
+    convergence: Path | None = None
+    deformed_png: Path | None = None
+
+
+@dataclass(frozen=True)
+class StudyArtefacts:
+    """A study (config ``studies.<name>``) and its drives' artefacts, drives in config order."""
+
+    name: str
+    source: str
+    designs: str
+    surrogate_bounds: str
+    drives: tuple[DriveArtefacts, ...]
+
+    @property
+    def units(self) -> list[str]:
+        """The study's drives (``hd42``, ``hd120``) in config order."""
+        return [d.unit for d in self.drives]
+
+    def drive(self, unit: str) -> DriveArtefacts:
+        """The artefacts of drive ``unit``; a ``KeyError`` when the study has no such drive."""
+        for d in self.drives:
+            if d.unit == unit:
+                return d
+        raise KeyError(f"study '{self.name}' has no drive {unit}")
+
+
+@dataclass(frozen=True)
+class CampaignArtefacts:
+    """A validation campaign's artefacts (``results/validation/{campaign}/``)."""
+
+    name: str
+    diagnosis: Path
+    ladder: Path
+    measured_png: Path
+    residuals_png: Path
+    ladder_png: Path
+
+
+@dataclass(frozen=True)
+class FeSettings:
+    """The FE settings the report quotes (config ``fe``): the default mesh and the load steps."""
+
+    mesh: MeshSettings
+    steps_per_ramp: int
+
+
+@dataclass(frozen=True)
+class ReportInputs:
+    """Everything ``results/report.pdf`` shows: every study and campaign, in config order, the
+    paper's tables, the FE settings and assumptions it quotes, and the provenance it prints."""
+
+    studies: tuple[StudyArtefacts, ...]
+    campaigns: tuple[CampaignArtefacts, ...]
+    data_dir: Path
+    fe_settings: FeSettings
+    assumptions: tuple[dict, ...]
+    provenance: dict
+
+    @property
+    def paper_studies(self) -> list[StudyArtefacts]:
+        """The studies on the paper's own FEA tables (source ``paper``)."""
+        return [s for s in self.studies if s.source == "paper"]
+
+    @property
+    def fe_studies(self) -> list[StudyArtefacts]:
+        """The studies solved with our FE model (source ``fe``)."""
+        return [s for s in self.studies if s.source == "fe"]

@@ -1,0 +1,89 @@
+"""The two reports, composed from the parts: ``study_report`` (a study on the paper's tables, its
+own PDF) and ``full_report`` (Part I the paper's tables, Part II our FE model, Part III the model
+against measurements). Each reads the artefacts it is given and writes only its PDF."""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+from hdwf.report.artefacts import ReportInputs, StudyArtefacts
+from hdwf.report.document import UNIT_NAMES, Document
+from hdwf.report.fe_part import fe_part
+from hdwf.report.paper_part import (comparison_section, correlation_section, designs_section, inputs_section,
+                                    paper_part, sobol_section, surrogate_section)
+from hdwf.report.validation_part import validation_part
+
+_SUBTITLES = {"paper": "The statistics chain on the paper's own FEA tables (Tables 4 and 5)"}
+
+
+def study_report(study: StudyArtefacts, data_dir, provenance: dict, out) -> Path:
+    """Typeset ``results/{study}/report.pdf`` from the study's artefacts.
+
+    Parameters
+    ----------
+    study
+        The study and its drives' artefacts.
+    data_dir
+        The paper's tables (config ``paper_data``).
+    provenance
+        The provenance printed under the title.
+    out
+        The PDF's path.
+
+    Returns
+    -------
+    Path
+        ``out``.
+    """
+    doc = Document(f"hdwf study '{study.name}': lost motion of harmonic drives",
+                   _SUBTITLES.get(study.source, study.source), provenance)
+    doc.text("This report reproduces the correlation, surrogate and global-sensitivity analysis of Majchrák et al., "
+             "*Global Sensitivity Analysis of Chosen Harmonic Drive Parameters Affecting Its Lost Motion*, for the "
+             f"drives {', '.join(UNIT_NAMES[u] for u in study.units)}. Every number and figure below was computed "
+             "by the workflow from the artefacts under `results/`; the provenance above identifies the "
+             "configuration, code and packages.")
+    inputs_section(doc, study.units, data_dir)
+    designs_section(doc, study)
+    doc.pagebreak()
+    correlation_section(doc, study)
+    doc.pagebreak()
+    surrogate_section(doc, study)
+    doc.pagebreak()
+    sobol_section(doc, study)
+    doc.pagebreak()
+    comparison_section(doc, study, data_dir)
+    return doc.compile(out)
+
+
+def full_report(report: ReportInputs, out) -> Path:
+    """Typeset ``results/report.pdf``: the paper replication, then our FE model and its studies,
+    then the model against measurements.
+
+    Parameters
+    ----------
+    report
+        Every study and campaign with their artefacts, and what the report quotes.
+    out
+        The PDF's path.
+
+    Returns
+    -------
+    Path
+        ``out``.
+    """
+    doc = Document("hdwf: lost motion of harmonic drives", "Paper replication, our FE model and its studies",
+                   report.provenance)
+    doc.text("Part I reproduces the statistics of Majchrák et al. from their own FEA tables; Part II solves the same "
+             "lost-motion test with our FE model, at our own optimal Latin hypercube (`fe`) and at the paper's design "
+             "points (`fe_at_paper`), and runs the same chain on it. Every number below was computed by the workflow "
+             "from the artefacts under `results/`.")
+    # Figures drawn here (not by a rule) live until the document is typeset.
+    with tempfile.TemporaryDirectory(prefix="hdwf-figs-") as tmp:
+        for study in report.paper_studies:
+            paper_part(doc, study, report.data_dir)
+        if report.fe_studies:
+            fe_part(doc, report, Path(tmp))
+        if report.campaigns:
+            validation_part(doc, report.campaigns)
+        return doc.compile(out)

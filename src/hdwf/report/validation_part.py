@@ -1,0 +1,226 @@
+"""Part III of the report, the model against measurements: a chapter per validation campaign (where
+the model fails, which effect is missing round by round, what the data could show at all, the
+error ladder), all read from the campaign's ``diagnosis.json``, ladder and figures."""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from hdwf.common.io import read_json
+from hdwf.report.artefacts import CampaignArtefacts
+from hdwf.report.document import UNIT_NAMES, Document, fmt, lit
+from hdwf.validation.effects import get as get_effect
+
+
+def _estimate(value: float, sd: float | None) -> str:
+    """A calibrated value with its standard deviation when the diagnosis gives one."""
+    return fmt(value, 4) + (f" ± {fmt(sd, 2)}" if sd is not None else "")
+
+
+def _effect_sentence(r: dict) -> str:
+    """A found effect in words: its title and calibrated parameter with unit."""
+    eff = get_effect(r["effect"])
+    (pname, val), = r["params"].items()
+    return f"*{lit(eff.title)}* ({lit(pname)} = {_estimate(val, r.get('param_sd'))} {lit(eff.param(pname).unit)})"
+
+
+def _detectability_rows(candidates: list[dict]) -> list[list[str]]:
+    """Per candidate: its realistic value, the change it makes, the noise it needs, ΔBIC and sd."""
+    rows = []
+    for c in candidates:
+        sd = c["expected_rel_sd"]
+        rows.append([lit(c["effect"]), f"{c['realistic']:g} {lit(c['unit'])}",
+                     fmt(c["change_rms_arcmin"], 3), fmt(c["change_max_arcmin"], 3),
+                     fmt(c["noise_to_show_arcmin"], 3), fmt(c["noise_to_calibrate_arcmin"], 3),
+                     fmt(c["expected_delta_bic"], 1),
+                     "–" if sd is None else "> 1000 %" if sd > 10 else f"{fmt(100 * sd, 2)} %",
+                     "yes" if c["visible"] else "no"])
+    return rows
+
+
+def detectability_section(doc: Document, diag: dict, level: int) -> None:
+    """Which candidates the campaign's data could have shown at all (``diagnosis.json``: detectability).
+
+    Nothing is added when the diagnosis has no detectability.
+
+    Parameters
+    ----------
+    doc
+        The document to add to.
+    diag
+        The campaign's ``diagnosis.json``.
+    level
+        Heading level of the section.
+    """
+    det = diag.get("detectability")
+    if not det:
+        return
+    doc.heading("What this data could show", level)
+    doc.table(["effect", "realistic value", "change RMS", "change max", "noise to show", "noise to calibrate",
+               "ΔBIC", "sd of parameter", "visible"], _detectability_rows(det["candidates"]),
+              f"Each candidate at a realistic value, against a noise of {fmt(det['noise_arcmin'], 4)} arcmin per "
+              f"value ({lit(det['noise_from'])}). Change: what the effect does to the predictions (arcmin). Noise to "
+              "show: the largest noise at which it would still pay (ΔBIC ≤ −10); noise to calibrate: at which its "
+              "parameter would come out within 15 % (two standard deviations). ΔBIC and sd: what this data would "
+              "give if the effect were there at that value (linearised).")
+    hidden = [c for c in det["candidates"] if c["effect"] in diag["verdict"].get("could_not_see", [])]
+    if hidden:
+        doc.text("This data could not have shown these effects at realistic values, so its verdict says nothing "
+                 "about them (not finding them is no evidence that they are absent): " + "; ".join(
+            f"{lit(get_effect(c['effect']).title)} (it changes the predictions by {fmt(c['change_rms_arcmin'], 2)} "
+            f"arcmin RMS and needs noise below {fmt(c['noise_to_show_arcmin'], 2)} arcmin)" for c in hidden)
+            + (". Less noise (averaged repeat runs, a finer encoder), more readings per curve or more specimens "
+               "would show them: a parameter's sd falls with the square root of the number of independent readings."
+               if diag.get("noise_arcmin") else
+               ". No noise is stated, so the final model's residual stands in for it; that residual also holds "
+               "whatever error the model cannot explain, and a large model error hides every candidate until it "
+               "is explained."))
+
+
+def refinement_notes(doc: Document, diag: dict) -> None:
+    """Which found effects the diagnosis re-solved before a further round, and where; a caution
+    for each re-solve that failed or did not settle.
+
+    Parameters
+    ----------
+    doc
+        The document to add to.
+    diag
+        The campaign's ``diagnosis.json``.
+    """
+    for name, r in diag.get("refinement", {}).items():
+        if r.get("solved_at"):
+            at = ", ".join(f"{v:.6g}" for v in r["solved_at"])
+            doc.text(f"Before round {r['before_round']}, {lit(name)} was recalibrated on actual FE solves of every "
+                     f"specimen at {lit(r['param'])} = {at} (solve {r['solves']}), so that round weighs its candidates "
+                     "against the FE model, not against the interpolation error of the tabulated values.")
+        if r["status"] in ("failed", "unsettled"):
+            doc.text(f"Caution, {lit(name)}: {lit(r['reason'])}.")
+
+
+def _campaign_intro(doc: Document, diag: dict) -> None:
+    """The measurements, the campaign's model and the candidates tried, in one paragraph."""
+    noise = diag.get("noise_arcmin")
+    doc.text(f"Measurements: {lit(diag['measurements'])}, {diag['n_specimens']} specimens, {diag['n_points']} values "
+             f"({lit(diag['form'])} form)"
+             + (f", stated noise {fmt(noise, 4)} arcmin" if noise else ", no noise stated")
+             + f". Model: our FE model on a mesh of {diag['mesh']['elements_over_height']} × "
+             f"{diag['mesh']['elements_over_thickness']} elements per tooth"
+             + (f", with {lit(', '.join(diag['model']['fixed']))} switched on" if diag["model"]["fixed"] else "") + ". "
+             + f"Candidates tried: {lit(', '.join(sorted(r['effect'] for r in diag['ranking'])))}.")
+
+
+def _where_it_fails(doc: Document, diag: dict, campaign: CampaignArtefacts, level: int) -> None:
+    """The comparison error overall and per worst specimen, tests on the residuals, and the figures."""
+    b = diag["baseline"]
+    doc.heading("Where the model fails", level)
+    rows = [["RMSE", fmt(b["rmse_arcmin"], 4)], ["bias (mean S − D)", fmt(b["bias_arcmin"], 4)],
+            ["largest |E|", fmt(b["max_abs_arcmin"], 4)], ["worst specimen", lit(b["worst_specimen"])]]
+    if b.get("u_val_arcmin") is not None:
+        rows += [["u_val (V&V 20)", fmt(b["u_val_arcmin"], 4)],
+                 ["points with |E| > 2 u_val", f"{fmt(100 * b['share_beyond_2uval'], 1)} %"]]
+    doc.table(["comparison error E = S − D", "arcmin"], rows, "The campaign's model against the measurements.")
+    doc.table(["specimen", "RMSE", "bias", "largest |E|"],
+              [[lit(w["specimen_id"]), fmt(w["rmse_arcmin"], 4), fmt(w["bias_arcmin"], 4), fmt(w["max_abs_arcmin"], 4)]
+               for w in diag["worst_specimens"]], "The specimens where the model fails worst (arcmin).")
+    if diag["residual_tests"]:
+        doc.table(["test on the residuals", "p-value", "small p means"],
+                  [[lit(t["test"]), fmt(t["p_value"], 3), lit(t["meaning"])] for t in diag["residual_tests"]],
+                  "statsmodels tests: a small p-value is a pattern in the error that the model does not explain.")
+    doc.figure(campaign.measured_png, "Measured against predicted: the campaign's model and the model with the found "
+               "effects switched on (calibrated values; table interpolation).")
+    doc.figure(campaign.residuals_png, "Residuals D − S against each input (specimen means) and along the test.")
+
+
+def _round_table(doc: Document, rnd: dict) -> None:
+    """Every candidate of one round, calibrated on top of that round's model."""
+    cur = "the campaign's model" if not rnd["model_effects"] else "the model with " + ", ".join(
+        lit(e) for e in rnd["model_effects"])
+    rows = []
+    for r in rnd["ranking"]:
+        (pname, val), = r["params"].items()
+        rows.append([lit(r["effect"]), f"{lit(pname)} = {_estimate(val, r.get('param_sd'))}"
+                     + (" (bound)" if r.get("at_bound") else "") + (" (off)" if r.get("calibrated_off") else ""),
+                     fmt(r["rmse_arcmin"], 4), fmt(r["delta_bic"], 1), fmt(r["loo_rmse_arcmin"], 4),
+                     fmt(r["signature_match"], 2), "yes" if r["pays"] else "no"])
+    doc.table(["effect", "calibrated", "RMSE", "ΔBIC", "LOO RMSE", "match", "pays"], rows,
+              f"Round {rnd['round']}: every candidate calibrated on top of {cur} (RMSE "
+              f"{fmt(rnd['current_rmse_arcmin'], 4)} arcmin). Pays: ΔBIC ≤ −10 and a lower leave-one-specimen-out "
+              "error; match: cosine between the change the effect makes and the residual (1 = same pattern).")
+
+
+def _round_verdict(rnd: dict) -> str:
+    """One round's verdict in words: no missing effect, or the effect found and what it does."""
+    v = rnd["verdict"]
+    if v["missing_effect"] is None:
+        return (f"Round {rnd['round']}: *no missing effect found.* No candidate lowers the error by more than "
+                "the data's scatter can explain (ΔBIC above −10, or no gain when a specimen is left out).")
+    best = next(r for r in rnd["ranking"] if r["effect"] == v["missing_effect"])
+    ties = v["indistinguishable_from"]
+    txt = (f"Round {rnd['round']}: the model misses {_effect_sentence(best)}. Switched on, it lowers the error "
+           f"from {fmt(rnd['current_rmse_arcmin'], 4)} to {fmt(best['rmse_arcmin'], 4)} arcmin (ΔBIC "
+           f"{fmt(best['delta_bic'], 1)}: very strong evidence), also for specimens left out of the fit, "
+           f"and the change it makes lines up with the residual (match {fmt(best['signature_match'], 2)}). "
+           f"Its signature: {lit(best['signature'])}.")
+    if ties:
+        txt += (f" The data cannot tell it from {lit(', '.join(ties))}: their signatures coincide here, so the "
+                "choice between them needs another test (different torque levels, temperatures or parts).")
+    if best.get("at_bound"):
+        txt += " Its best value sits on the bound of its range: treat it as a stand-in, not an explanation."
+    return txt
+
+
+def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2) -> None:
+    """One campaign: where the model fails, which effect is missing, what the data could show, the ladder.
+
+    Parameters
+    ----------
+    doc
+        The document to add to.
+    campaign
+        The campaign's artefacts.
+    level
+        Heading level of the chapter; its sections are one level below.
+    """
+    diag = read_json(campaign.diagnosis)
+    ladder = pd.read_parquet(campaign.ladder)
+    noise = diag.get("noise_arcmin")
+    doc.heading(f"Campaign '{campaign.name}' ({UNIT_NAMES[diag['unit']]})", level)
+    _campaign_intro(doc, diag)
+    _where_it_fails(doc, diag, campaign, level + 1)
+    doc.heading("Which effect is missing", level + 1)
+    for rnd in diag["rounds"]:
+        _round_table(doc, rnd)
+        doc.text(_round_verdict(rnd))
+    refinement_notes(doc, diag)
+    detectability_section(doc, diag, level + 1)
+    doc.heading("Adding it: the error ladder", level + 1)
+    doc.table(["rung", "model", "RMSE", "bias", "largest |E|", "ΔBIC"],
+              [[str(r["rung"]), lit(r["model"]), fmt(r["rmse_arcmin"], 4), fmt(r["bias_arcmin"], 4),
+                fmt(r["max_abs_arcmin"], 4), fmt(r["delta_bic"], 1)] for r in ladder.to_dict("records")],
+              "Each rung re-solved with the FE model (not interpolated): the found effects switched on at their "
+              "calibrated values. ΔBIC against the first rung."
+              + (f" Stated noise: {fmt(noise, 4)} arcmin." if noise else ""))
+    doc.figure(campaign.ladder_png, "The error falling rung by rung.", width="75%")
+    for name, note in diag.get("notes", {}).items():
+        doc.text(f"Note on {lit(name)}: {lit(note)}.")
+
+
+def validation_part(doc: Document, campaigns: tuple[CampaignArtefacts, ...]) -> None:
+    """Part III: a chapter per campaign, in config order.
+
+    Parameters
+    ----------
+    doc
+        The document to add to.
+    campaigns
+        The campaigns shown.
+    """
+    doc.pagebreak()
+    doc.heading("Part III — the model against measurements", 1)
+    doc.text("Each campaign holds the FE model against a measurement file, shows where it fails, calibrates "
+             "every candidate physical effect (each a change to the FE model), names the missing one only "
+             "when it pays beyond the noise, and re-solves the model with it switched on "
+             "(docs/validation.md).")
+    for c in campaigns:
+        campaign_chapter(doc, c, 2)

@@ -1,0 +1,106 @@
+"""The reports built from a paper study's artefacts (drive HD 42, a short Sobol' run): the rule's
+named inputs regrouped into typed records, the sections of Part I, and the PDFs."""
+
+import shutil
+import subprocess
+
+import pytest
+
+from hdwf import PARAMETERS
+from hdwf.report.document import Document
+from hdwf.report.paper_part import comparison_section, designs_section, sobol_section
+from hdwf.stages.doe import doe_stage
+from hdwf.stages.paper import paper_lost_motion_stage
+from hdwf.stages.report import artefacts_by_owner, full_report_stage, study_artefacts, study_report_stage
+from hdwf.stages.stats import correlation_stage, sobol_stage, surrogate_stage
+from hdwf.study.paper import table3_bounds
+
+from conftest import DATA
+
+PROVENANCE = {"config_hash": "0" * 64, "git_commit": "0" * 40, "python": "3.11", "packages": {"typst": "x"}}
+STUDY = {"source": "paper", "units": ["hd42"], "designs": "paper", "surrogate_bounds": "design_range"}
+SOBOL = {"n_start": 64, "n_min": 128, "n_max": 256, "tolerance": 0.002, "seed": 1, "num_resamples": 10,
+         "conf_level": 0.95}
+
+
+@pytest.fixture(scope="module")
+def named_inputs(tmp_path_factory):
+    """The artefacts of study ``paper`` for HD 42, as the rule study_report names them."""
+    root = tmp_path_factory.mktemp("results")
+    d = root / "paper" / "hd42"
+    t3 = table3_bounds(DATA, "hd42")
+    paper_lost_motion_stage(DATA, "hd42", d / "lost_motion.parquet", PROVENANCE)
+    doe_stage(t3, 27, 1, "none", root / "doe/hd42/designs.parquet", PROVENANCE, "hd42")
+    correlation_stage(d / "lost_motion.parquet", d / "correlation.parquet", d / "correlation.png", "c", PROVENANCE)
+    surrogate_stage(d / "lost_motion.parquet", d / "surrogate.json", d / "surrogate.png", "design_range", t3, "s",
+                    PROVENANCE)
+    sobol_stage(d / "surrogate.json", d / "sobol.parquet", d / "sobol_convergence.png", ["sobol"], SOBOL, "i",
+                PROVENANCE, other_bounds={"table3": ([t3[p][0] for p in PARAMETERS], [t3[p][1] for p in PARAMETERS])})
+    names = {"lost_motion": "lost_motion.parquet", "correlation": "correlation.parquet",
+             "correlation_png": "correlation.png", "surrogate": "surrogate.json", "surrogate_png": "surrogate.png",
+             "sobol": "sobol.parquet", "sobol_png": "sobol_convergence.png"}
+    inputs = {kind: [str(d / name)] for kind, name in names.items()}
+    inputs["doe"] = [str(root / "doe/hd42/designs.parquet")]
+    owners = {kind: [["paper", "hd42"]] for kind in inputs}
+    return inputs, owners
+
+
+def test_inputs_are_regrouped_by_owner():
+    inputs = {"sobol": ["a/s", "b/s"], "diagnosis": ["v/d"]}
+    owners = {"sobol": [["paper", "hd42"], ["fe", "hd120"]], "diagnosis": [["demo"]]}
+    grouped = artefacts_by_owner(inputs, owners)
+    assert list(grouped) == [("paper", "hd42"), ("fe", "hd120"), ("demo",)]
+    assert str(grouped[("fe", "hd120")]["sobol"]) == "b/s" and str(grouped[("demo",)]["diagnosis"]) == "v/d"
+    with pytest.raises(ValueError):
+        artefacts_by_owner({"sobol": ["a/s"]}, {"sobol": [["paper", "hd42"], ["fe", "hd120"]]})
+
+
+def test_a_study_record_needs_every_artefact(named_inputs):
+    inputs, owners = named_inputs
+    study = study_artefacts("paper", STUDY, artefacts_by_owner(inputs, owners))
+    assert study.units == ["hd42"] and study.drive("hd42").curves is None
+    with pytest.raises(KeyError):
+        study.drive("hd120")
+    partial = {k: v for k, v in inputs.items() if k != "sobol"}  # every kind the rule names is needed
+    with pytest.raises(TypeError):
+        study_artefacts("paper", STUDY, artefacts_by_owner(partial, owners))
+
+
+def test_part_one_sections(named_inputs):
+    study = study_artefacts("paper", STUDY, artefacts_by_owner(*named_inputs))
+    doc = Document("t", "s", PROVENANCE)
+    designs_section(doc, study)
+    sobol_section(doc, study)
+    comparison_section(doc, study, DATA)
+    tables = [b for b in doc.blocks if b["type"] == "table"]
+    assert len(tables[0]["rows"]) == 27 and tables[0]["rows"][0][0] == "paper-01"
+    assert [r[0] for r in tables[1]["rows"]] == ["HD 42 paper design", "HD 42 our LHS (seed 1)"]
+    # only the Sobol' sampler ran: the other samplers' columns are dashes; no check at N = 65536
+    assert all(r[3:7] == ["–"] * 4 for r in tables[2]["rows"])
+    assert not any("65536" in b.get("text", "") for b in doc.blocks)
+    assert {r[0] for r in tables[3]["rows"]} == {"HD 42"}
+    assert "*design range* bounds" in doc.blocks[-4]["text"]
+
+
+def _pdf_text(pdf) -> str:
+    return subprocess.run(["pdftotext", str(pdf), "-"], capture_output=True, text=True, check=True).stdout
+
+
+def test_study_report_stage_writes_the_pdf(named_inputs, tmp_path):
+    inputs, owners = named_inputs
+    pdf = study_report_stage("paper", STUDY, inputs, owners, DATA, PROVENANCE, tmp_path / "report.pdf")
+    assert pdf.read_bytes()[:5] == b"%PDF-" and list(tmp_path.iterdir()) == [pdf]
+    if shutil.which("pdftotext"):
+        text = _pdf_text(pdf)
+        # captions are markup, with typst's curly quotes; the title is plain text
+        assert "hdwf study 'paper'" in text and "Replication of the paper’s published statistics." in text
+
+
+def test_full_report_stage_with_a_paper_study_only(named_inputs, tmp_path):
+    inputs, owners = named_inputs
+    fe = {"elements_over_height": 10, "elements_over_thickness": 6, "refinement": 1.0, "steps_per_ramp": 5}
+    pdf = full_report_stage({"paper": STUDY}, fe, inputs, owners, DATA, PROVENANCE, tmp_path / "report.pdf")
+    assert pdf.read_bytes()[:5] == b"%PDF-"
+    if shutil.which("pdftotext"):
+        text = _pdf_text(pdf)
+        assert "Part I — the paper's FEA tables (study 'paper')" in text and "Part II — our FE model" not in text
