@@ -1,4 +1,4 @@
-# Shared helpers: which studies, drives and designs exist; where the repository is (provenance).
+# Shared helpers: which studies, drives and designs exist.
 
 from hdwf.study.paper import FEA_TABLES
 

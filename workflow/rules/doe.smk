@@ -9,7 +9,6 @@ rule doe:
         n=config["doe"]["n_designs"],
         seed=config["doe"]["seed"],
         optimization=config["doe"]["optimization"],
-        repo=REPO_DIR,
     log:
         "results/logs/doe_{unit}.log",
     script:

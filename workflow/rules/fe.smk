@@ -17,7 +17,6 @@ rule fe_designs:
     params:
         designs=lambda w: STUDIES[w.study]["designs"],
         data_dir=config["paper_data"],
-        repo=REPO_DIR,
     log:
         "results/logs/{study}_{unit}_designs.log",
     script:
@@ -32,7 +31,6 @@ rule fe_mesh:
         npz="results/{study}/{unit}/mesh/{design}.npz",
     params:
         settings={k: FE[k] for k in ("elements_over_height", "elements_over_thickness", "refinement", "symmetry")},
-        repo=REPO_DIR,
     threads: 1
     log:
         "results/logs/{study}_{unit}_mesh_{design}.log",
@@ -49,7 +47,6 @@ rule fe_solve:
         curve="results/{study}/{unit}/designs/{design}_curve.parquet",
     params:
         steps_per_ramp=FE["steps_per_ramp"],
-        repo=REPO_DIR,
     threads: 1
     resources:
         mem_mb=4000,
@@ -74,7 +71,6 @@ rule fe_aggregate:
     wildcard_constraints:
         study=_alternatives(FE_STUDIES),
     params:
-        repo=REPO_DIR,
     log:
         "results/logs/{study}_{unit}_aggregate.log",
     script:
@@ -92,7 +88,6 @@ rule fe_refined_solve:
                             "elements_over_thickness": FE["elements_over_thickness"], "refinement": float(w.ref),
                             "symmetry": FE["symmetry"]},
         steps_per_ramp=FE["steps_per_ramp"],
-        repo=REPO_DIR,
     threads: 1
     resources:
         mem_mb=4000,
@@ -123,7 +118,6 @@ rule fe_convergence:
         study=_alternatives(FE_STUDIES),
     params:
         refinement=FE["refinement"],
-        repo=REPO_DIR,
     log:
         "results/logs/{study}_{unit}_convergence.log",
     script:
@@ -140,7 +134,6 @@ rule fe_deformed:
     params:
         settings={k: FE[k] for k in ("elements_over_height", "elements_over_thickness", "refinement", "symmetry")},
         steps_per_ramp=FE["steps_per_ramp"],
-        repo=REPO_DIR,
     threads: 1
     log:
         "results/logs/{study}_{unit}_deformed_{design}.log",

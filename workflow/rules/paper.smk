@@ -9,7 +9,6 @@ rule paper_lost_motion:
         study=_alternatives(PAPER_STUDIES),
     params:
         data_dir=config["paper_data"],
-        repo=REPO_DIR,
     log:
         "results/logs/{study}_{unit}_lost_motion.log",
     script:

@@ -72,7 +72,6 @@ rule study_report:
         owners=lambda w: study_report_files(w)[1],
         study_config=lambda w: STUDIES[w.study],
         data_dir=config["paper_data"],
-        repo=REPO_DIR,
     log:
         "results/logs/{study}_report.log",
     script:
@@ -89,7 +88,6 @@ rule full_report:
         studies=STUDIES,
         fe_settings={k: v for k, v in FE.items() if k not in ("convergence", "picture")},
         data_dir=config["paper_data"],
-        repo=REPO_DIR,
     log:
         "results/logs/report.log",
     script:

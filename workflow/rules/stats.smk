@@ -7,7 +7,6 @@ rule correlation:
         table="results/{study}/{unit}/correlation.parquet",
         figure="results/{study}/{unit}/correlation.png",
     params:
-        repo=REPO_DIR,
     log:
         "results/logs/{study}_{unit}_correlation.log",
     script:
@@ -24,7 +23,6 @@ rule surrogate:
     params:
         bounds_source=lambda w: STUDIES[w.study]["surrogate_bounds"],
         data_dir=config["paper_data"],
-        repo=REPO_DIR,
     log:
         "results/logs/{study}_{unit}_surrogate.log",
     script:
@@ -41,7 +39,6 @@ rule sobol:
         settings={k: v for k, v in config["sobol"].items() if k != "samplers"},
         samplers=config["sobol"]["samplers"],
         data_dir=config["paper_data"],
-        repo=REPO_DIR,
     log:
         "results/logs/{study}_{unit}_sobol.log",
     script:

@@ -11,10 +11,14 @@ PROJECT_ROOT = Path(__file__).resolve().parents[2]
 
 
 def setup(snakemake):
-    """Log to the rule's log file; return the provenance stamped on every artefact."""
+    """Log to the rule's log file; return the provenance stamped on every artefact.
+
+    The git commit is read from the checkout this script lives in, found from the script's own
+    path, so no rule passes an absolute path as a parameter (a moved project plans no reruns).
+    """
     logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, force=True,
                         format="%(asctime)s %(levelname)s %(message)s")
-    return provenance(snakemake.config, snakemake.params.repo)
+    return provenance(snakemake.config, PROJECT_ROOT)
 
 
 def mock_snakemake(rule: str, configfiles: list[str] | None = None, **wildcards):
