@@ -23,7 +23,7 @@ import pandas as pd
 import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _workspace import ROOT, copy_workflow  # noqa: E402
+from _workspace import copy_workflow  # noqa: E402
 BIN = Path(sys.executable).parent
 
 

@@ -1,7 +1,7 @@
 """Which noise does each candidate effect need to be found? Measured against predicted.
 
 For every candidate effect at its realistic value (and for no effect), the FE model makes
-the curves of N HD 42 specimens once (coarse test mesh, as in tests/test_hidden_effects.py);
+the curves of N HD 42 specimens once (coarse test mesh, as in tests/validation/test_hidden_effects.py);
 Gaussian noise of several levels, with several seeds, is added; each data set is diagnosed
 (one round). A row counts how often the effect was named (first, or among the
 indistinguishable), how often its parameter came back within 15 %, and whether the
@@ -23,12 +23,12 @@ from pathlib import Path
 
 import numpy as np
 
-from hdwf.validation.campaign import (add_noise, design_ranges, format_ranges, mean_lost_motion, parse_range,
-                           plan_variants, specimen_solver, synth_curves, synth_designs)
-from hdwf.validation.diagnosis import diagnose
-from hdwf.validation.effects import registry
 from hdwf.common.io import atomic_path
+from hdwf.validation.diagnosis import Search, diagnose
+from hdwf.validation.effects import registry
 from hdwf.validation.measurements import load_measurements
+from hdwf.validation.synthesis import add_noise, design_ranges, format_ranges, parse_range, synth_curves, synth_designs
+from hdwf.validation.variants import SolveSetup, mean_lost_motion, plan_variants, specimen_solver
 
 UNIT = "hd42"
 DESIGN_SEED = 11
@@ -57,7 +57,8 @@ def main():
     t0 = time.perf_counter()
     specimens = synth_designs(UNIT, args.specimens, DESIGN_SEED, ranges)
     plan = plan_variants({})
-    tables = specimen_solver(UNIT, specimens, SETTINGS, args.steps_per_ramp, args.jobs)(plan)
+    setup = SolveSetup(UNIT, SETTINGS, args.steps_per_ramp, args.jobs)
+    tables = specimen_solver(setup, specimens)(plan)
     signal = mean_lost_motion(tables)
     print(f"tables: {time.perf_counter() - t0:.0f} s; mean lost motion {signal:.3f} arcmin")
 
@@ -68,8 +69,7 @@ def main():
             if effect:
                 p = registry()[effect].parameters[0]
                 hidden = {effect: {p.name: p.realistic}}
-            clean = synth_curves(UNIT, args.specimens, DESIGN_SEED, hidden, SETTINGS, args.steps_per_ramp,
-                                 jobs=args.jobs, ranges=ranges)
+            clean = synth_curves(setup, args.specimens, DESIGN_SEED, hidden, ranges)
             for pct in args.noise_pct:
                 noise = pct / 100 * signal
                 named = recovered = 0
@@ -78,7 +78,7 @@ def main():
                     path = Path(tmp) / f"{effect}-{pct}-{seed}.csv"
                     add_noise(clean, noise, seed).to_csv(path, index=False)
                     t1 = time.perf_counter()
-                    diag, _ = diagnose(load_measurements(path), tables, max_rounds=1)
+                    diag = diagnose(load_measurements(path), tables, Search(max_rounds=1)).to_dict()
                     secs.append(time.perf_counter() - t1)
                     v = diag["verdict"]
                     if effect is None:

@@ -8,20 +8,24 @@ import sys
 from pathlib import Path
 
 from hdwf.common.errors import InputError
+from hdwf.common.io import atomic_path
+from hdwf.common.provenance import provenance
+from hdwf.config import config_hash, load_config
+from hdwf.study.paper import paper_measurements
+from hdwf.validation.detectability import plan_detectability
+from hdwf.validation.effects import parse_assignment, registry
+from hdwf.validation.jsonsafe import json_safe
+from hdwf.validation.synthesis import design_ranges, format_ranges, parse_range, synth_designs, synthesize
+from hdwf.validation.variants import SolveSetup
 
 
 def _check_config(args) -> int:
-    from hdwf.config import config_hash, load_config
-
     config = load_config(args.config, args.schema)
     print(f"{args.config}: valid; config hash {config_hash(config)}")
     return 0
 
 
 def _provenance(args) -> int:
-    from hdwf.config import load_config
-    from hdwf.common.provenance import provenance
-
     config = load_config(args.config, args.schema)
     print(json.dumps(provenance(config, Path(args.config).resolve().parent), indent=2))
     return 0
@@ -33,11 +37,12 @@ def _refuse_existing(out: Path, args, why: str = "") -> None:
         raise InputError(out, f"exists; {why}use --force to replace it", field="--out")
 
 
-def _mesh_settings(args) -> dict:
-    """FE mesh settings of the synth/plan solves (half model) from their options."""
-    return {"elements_over_height": args.elements_over_height,
+def _solve_setup(args) -> SolveSetup:
+    """How the synth/plan solves run (half model) from their options."""
+    mesh = {"elements_over_height": args.elements_over_height,
             "elements_over_thickness": args.elements_over_thickness,
             "refinement": args.refinement, "symmetry": "half"}
+    return SolveSetup(args.unit, mesh, args.steps_per_ramp, args.jobs)
 
 
 def _specimen_options(p, seed_help: str, noise_help: str) -> None:
@@ -52,8 +57,6 @@ def _specimen_options(p, seed_help: str, noise_help: str) -> None:
 
 def _design_ranges(args) -> dict[str, tuple[float, float]]:
     """The --range options as {column: (low, high)}, checked against the model's support."""
-    from hdwf.validation.campaign import design_ranges, parse_range
-
     ranges = {}
     for text in args.range:
         try:
@@ -76,10 +79,6 @@ def _solve_options(p, elements_over_height: int, elements_over_thickness: int) -
 
 
 def _synth(args) -> int:
-    from hdwf.validation.campaign import format_ranges, synthesize
-    from hdwf.validation.effects import parse_assignment
-    from hdwf.common.io import atomic_path
-
     out = Path(args.out)
     if out.suffix.lower() not in (".csv", ".parquet"):
         raise InputError(out, f"unknown file type '{out.suffix}': write .csv or .parquet", field="--out")
@@ -93,8 +92,7 @@ def _synth(args) -> int:
             raise InputError("command line", str(exc).strip("'\""), field="--effect", value=text) from None
         effects.setdefault(name, {})[pname] = value
     try:
-        data = synthesize(args.unit, args.designs, args.seed, args.noise_arcmin, effects, _mesh_settings(args),
-                          steps_per_ramp=args.steps_per_ramp, jobs=args.jobs, ranges=ranges)
+        data = synthesize(_solve_setup(args), args.designs, args.seed, args.noise_arcmin, effects, ranges)
     except ValueError as exc:
         raise InputError("command line", str(exc)) from None
     with atomic_path(out) as tmp:
@@ -110,8 +108,6 @@ def _synth(args) -> int:
 
 
 def _effects(args) -> int:
-    from hdwf.validation.effects import registry
-
     for eff in registry().values():
         print(f"{eff.name}: {eff.title}{' (in series at the output)' if eff.series else ''}")
         for p in eff.parameters:
@@ -122,42 +118,34 @@ def _effects(args) -> int:
 
 
 def _plan(args) -> int:
-    from hdwf.validation.campaign import format_ranges, synth_designs
-    from hdwf.validation.diagnosis import json_safe, plan_detectability
-    from hdwf.common.io import atomic_path
-
     out = Path(args.out) if args.out else None
     if out is not None:
         _refuse_existing(out, args)
     ranges = _design_ranges(args)
     try:
         specimens = synth_designs(args.unit, args.designs, args.seed, ranges)
-        plan = plan_detectability(args.unit, specimens, _mesh_settings(args), args.steps_per_ramp,
-                                  args.noise_arcmin, jobs=args.jobs)
+        plan = plan_detectability(_solve_setup(args), specimens, args.noise_arcmin)
     except ValueError as exc:
         raise InputError("command line", str(exc)) from None
     batch = format_ranges(ranges)
-    print(f"{plan['n_specimens']} specimens of {args.unit}{batch} (mean lost motion {plan['mean_lost_motion_arcmin']:.3f} "
-          f"arcmin), {plan['n_points']} points, noise {args.noise_arcmin:g} arcmin per point:")
+    print(f"{plan.n_specimens} specimens of {args.unit}{batch} (mean lost motion {plan.mean_lost_motion_arcmin:.3f} "
+          f"arcmin), {plan.n_points} points, noise {args.noise_arcmin:g} arcmin per point:")
     print(f"  {'effect':<16} {'realistic':>12} {'change RMS':>11} {'noise to show':>14} {'to calibrate':>13} "
           f"{'sd':>7}  visible")
-    for c in plan["candidates"]:
-        sd = c["expected_rel_sd"]
-        print(f"  {c['effect']:<16} {c['realistic']:>12.4g} {c['change_rms_arcmin']:>11.4f} "
-              f"{c['noise_to_show_arcmin']:>14.4f} {c['noise_to_calibrate_arcmin']:>13.4f} "
-              f"{(f'{100 * sd:.0f} %' if sd < 10 else '>1000 %'):>7}  {'yes' if c['visible'] else 'no'}")
+    for c in plan.candidates:
+        sd = c.expected_rel_sd
+        print(f"  {c.effect:<16} {c.realistic:>12.4g} {c.change_rms_arcmin:>11.4f} "
+              f"{c.noise_to_show_arcmin:>14.4f} {c.noise_to_calibrate_arcmin:>13.4f} "
+              f"{(f'{100 * sd:.0f} %' if sd < 10 else '>1000 %'):>7}  {'yes' if c.visible else 'no'}")
     print("  (arcmin; noise to show: ΔBIC -10; to calibrate: parameter within 15 % at two sd)")
     if out is not None:
         with atomic_path(out) as tmp:
-            Path(tmp).write_text(json.dumps(json_safe(plan), indent=1))
+            Path(tmp).write_text(json.dumps(json_safe(plan.to_dict()), indent=1))
         print(f"{out}: written")
     return 0
 
 
 def _paper_measurements(args) -> int:
-    from hdwf.common.io import atomic_path
-    from hdwf.study.paper import paper_measurements
-
     out = Path(args.out)
     _refuse_existing(out, args, "measurement files are never overwritten: ")
     data = paper_measurements(args.data, args.unit)
@@ -168,6 +156,7 @@ def _paper_measurements(args) -> int:
 
 
 def main(argv=None) -> int:
+    """Run the ``hdwf`` command ``argv`` (default: the process's arguments); its exit status."""
     parser = argparse.ArgumentParser(prog="hdwf", description="Harmonic-drive lost-motion study tools.")
     sub = parser.add_subparsers(dest="command", required=True)
     for name, func, help_ in (("check-config", _check_config, "validate a config file against the schema"),

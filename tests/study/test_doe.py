@@ -58,7 +58,7 @@ def test_synth_designs_sample_a_batch_inside_its_range():
     """`--range` narrows the Latin hypercube of a synthetic campaign: one specimen in each of
     the n equal strata of the narrowed range (the LHS property), the other parameters on the
     paper's Table 3 ranges as before, the same seed giving the same specimens."""
-    from hdwf.validation.campaign import synth_designs
+    from hdwf.validation.synthesis import synth_designs
 
     n = 8
     batch = synth_designs("hd42", n, 3, {"rFS_mm": (0.0, 0.002), "rCS_mm": (0.001, 0.001)})

@@ -7,12 +7,12 @@ import math
 import numpy as np
 import pytest
 
+from hdwf.drive.geometry import drive_geometry
+from hdwf.drive.mesh import build_mesh
+from hdwf.fe import ModelChanges, solve_lost_motion, solve_lost_motion_variants
 from hdwf.validation.effects import model_changes, parse_assignment, registry
 from hdwf.validation.effects.oldham_play import ARCSEC
 from hdwf.validation.effects.thermal import ALPHA_STEEL
-from hdwf.fe import ModelChanges, solve_lost_motion
-from hdwf.drive.geometry import drive_geometry
-from hdwf.drive.mesh import build_mesh
 
 ARCMIN = math.pi / (180 * 60)
 
@@ -67,6 +67,7 @@ def test_bad_effect_settings_are_refused_with_names():
         parse_assignment("thermal=3")
 
 
+@pytest.mark.slow
 def test_series_elements_add_exactly(drive, baseline):
     """A spring in series adds T/K at each end of the test (Φ + 2 T/K); a dead band adds its
     width to Φ; neither changes the contact solution."""
@@ -80,6 +81,7 @@ def test_series_elements_add_exactly(drive, baseline):
     assert r.teeth_in_contact == baseline.teeth_in_contact
 
 
+@pytest.mark.slow
 def test_stiff_housing_is_the_clamped_rim(drive, baseline):
     """Springs of 1e9 N/mm² on the CS rim are a clamp to within 1e-6 of Φ; soft ones add compliance."""
     stiff = _solve(drive, cs_rim_stiffness_N_mm2=1e9)
@@ -88,6 +90,7 @@ def test_stiff_housing_is_the_clamped_rim(drive, baseline):
     assert soft.phi_plus_arcmin > baseline.phi_plus_arcmin * 1.02
 
 
+@pytest.mark.slow
 def test_housing_compliance_follows_the_elastic_foundation_law(drive, baseline):
     """A ring on an elastic foundation deflects as k^-3/4 (Hetényi): a tenfold softer housing
     adds 10^0.75 = 5.6 times the lost motion, not 10 times. The calibration tabulates the
@@ -113,6 +116,7 @@ def test_transformed_parameter_round_trip_and_uncertainty():
         assert p.sd_from_t(t, 1e-3 * t) == pytest.approx(abs(slope) * 1e-3 * t, rel=1e-6)
 
 
+@pytest.mark.slow
 def test_thermal_growth_closes_the_flank_clearance(drive, baseline):
     """FS warmer by dT: its teeth move out by alpha dT r, which closes each flank's circumferential
     clearance by alpha dT r tan(alpha_tip) (contact at the FS tip, whose pressure angle is
@@ -127,6 +131,7 @@ def test_thermal_growth_closes_the_flank_clearance(drive, baseline):
     assert hot.phi_plus_arcmin == pytest.approx(baseline.phi_plus_arcmin, rel=0.01)
 
 
+@pytest.mark.slow
 def test_friction_dissipates_and_vanishes_at_zero(drive, baseline):
     """mu = 0 is the frictionless model; mu > 0 opens a loop that dissipates energy: on the
     positive half, the unloading branch lies above the loading branch at every torque
@@ -144,12 +149,11 @@ def test_friction_dissipates_and_vanishes_at_zero(drive, baseline):
     assert min(widths) > 0
 
 
+@pytest.mark.slow
 def test_shared_variants_equal_separate_solves(drive):
     """The campaign tables come from ``solve_lost_motion_variants`` (one mounted wave
     generator, a kept CS factorisation for a pure thermal scaling): each variant must give the
     curve a separate ``solve_lost_motion`` gives, to round-off."""
-    from hdwf.fe import solve_lost_motion_variants
-
     variants = [ModelChanges(),
                 model_changes({"thermal": {"delta_T_K": 20.0}}),
                 model_changes({"thermal": {"delta_T_K": -30.0}}),

@@ -13,7 +13,7 @@ motion is 0.18 arcmin per point, while cup torsion and housing compliance at rea
 change the twist at ±T by about 0.05 and 0.02 arcmin (0.032 and 0.014 arcmin RMS over a
 curve), friction by 0.01. What data can show grows with the number of independent points
 and falls with the noise: the parameter's relative sd is σ/|Δ|, |Δ| the norm of the change
-over all points (diagnosis.detectability).
+over all points (hdwf.validation.detectability).
 
 * The paper's design space, curves of 21 points (5 steps per ramp): the dead-band effects
   (thermal, Oldham play) are found at 2 % noise; at 2 % the elastic ones are rightly not
@@ -42,10 +42,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from hdwf.validation.campaign import (mean_lost_motion, plan_variants, specimen_solver, synth_designs,
-                           synthesize, variant_key)
-from hdwf.validation.diagnosis import diagnose
+from hdwf.validation.detectability import detectability_of_tables
+from hdwf.validation.diagnosis import Search, diagnose
 from hdwf.validation.measurements import load_measurements
+from hdwf.validation.synthesis import synth_designs, synthesize
+from hdwf.validation.variants import (SolveSetup, candidate_names, mean_lost_motion, plan_variants, specimen_solver,
+                                      variant_key)
 
 UNIT = "hd42"
 N_SPECIMENS = 12
@@ -70,6 +72,13 @@ REALISTIC = {
 # expected sd is 7 % rather than 10 % at 0.08, where noise seed 11 misses 15 % (module docstring)
 BATCH_VALUES = {**REALISTIC, "tooth_friction": ("mu", 0.10)}
 
+# every test here solves the FE model (the module's tables alone take minutes)
+pytestmark = pytest.mark.slow
+
+
+def _setup(steps):
+    return SolveSetup(UNIT, SETTINGS, steps, JOBS)
+
 
 @pytest.fixture(scope="module")
 def specimens():
@@ -78,7 +87,7 @@ def specimens():
 
 def _campaign_tables(specimens, steps):
     """The campaign model and every candidate's grid, solved for every specimen."""
-    return specimen_solver(UNIT, specimens, SETTINGS, steps, JOBS)(plan_variants({}))
+    return specimen_solver(_setup(steps), specimens)(plan_variants({}))
 
 
 @pytest.fixture(scope="module")
@@ -110,8 +119,7 @@ def signal(tables):
 
 def _measure(tmp_path, specimens, effects, noise, steps=STEPS, ranges=None):
     """``hdwf synth`` in-process: same specimens as the tables, the hidden effects on."""
-    data = synthesize(UNIT, N_SPECIMENS, SEED, noise, effects, SETTINGS, steps_per_ramp=steps, jobs=JOBS,
-                      ranges=ranges)
+    data = synthesize(_setup(steps), N_SPECIMENS, SEED, noise, effects, ranges)
     # the synthesiser draws the same Latin hypercube: the specimens must be the tables' ones
     pd.testing.assert_frame_equal(data.drop_duplicates("specimen_id")[specimens.columns].reset_index(drop=True),
                                   specimens.reset_index(drop=True))
@@ -122,7 +130,7 @@ def _measure(tmp_path, specimens, effects, noise, steps=STEPS, ranges=None):
 
 def _rmse_switched_on(meas, specimens, effects, steps=STEPS):
     """RMSE of the model with the calibrated effects switched on: actual solves, not the tables."""
-    table = specimen_solver(UNIT, specimens, SETTINGS, steps, JOBS)([effects])
+    table = specimen_solver(_setup(steps), specimens)([effects])
     pred = table[["specimen_id", "step", "twist_arcmin"]].rename(columns={"twist_arcmin": "S"})
     pts = meas.data.merge(pred, on=["specimen_id", "step"])
     return float(np.sqrt(np.mean((pts["S"] - pts["twist_arcmin"]) ** 2)))
@@ -142,7 +150,7 @@ def _check_found(diag, effect, param, true, meas, specimens, noise, steps=STEPS)
 def _hidden_one(tmp_path, specimens, tables, effect, noise, steps=STEPS, ranges=None, values=REALISTIC):
     param, true = values[effect]
     meas = _measure(tmp_path, specimens, {effect: {param: true}}, noise, steps, ranges)
-    diag, _ = diagnose(meas, tables)
+    diag = diagnose(meas, tables).to_dict()
     # the diagnosis's own estimate agrees: this data can show the effect
     assert effect not in diag["verdict"]["could_not_see"], diag["detectability"]
     _check_found(diag, effect, param, true, meas, specimens, noise, steps)
@@ -172,7 +180,7 @@ def test_elastic_effect_found_at_two_percent_noise_on_a_dense_catalogue_grade_ba
 def test_no_hidden_effect_no_verdict(tmp_path, specimens, tables, signal):
     """The baseline model itself plus noise: nothing may pay."""
     meas = _measure(tmp_path, specimens, {}, 0.02 * signal)
-    diag, _ = diagnose(meas, tables)
+    diag = diagnose(meas, tables).to_dict()
     assert diag["verdict"]["missing_effect"] is None, diag["verdict"]
     assert diag["verdict"]["text"] == "no missing effect found"
 
@@ -183,7 +191,7 @@ def test_elastic_effects_are_not_claimed_below_the_noise(tmp_path, specimens, ta
     the honest answer is no verdict, not a guess."""
     param, true = REALISTIC["fs_cup_torsion"]
     meas = _measure(tmp_path, specimens, {"fs_cup_torsion": {param: true}}, 0.02 * signal)
-    diag, _ = diagnose(meas, tables)
+    diag = diagnose(meas, tables).to_dict()
     assert diag["verdict"]["missing_effect"] is None, diag["verdict"]
     # ... and it says why: at their realistic values these effects are below this data's noise
     assert {"fs_cup_torsion", "cs_housing", "tooth_friction"} <= set(diag["verdict"]["could_not_see"])
@@ -203,12 +211,12 @@ def test_two_hidden_effects_found_in_two_rounds(tmp_path, batch_specimens, dense
     meas = _measure(tmp_path, batch_specimens, hidden, noise, DENSE_STEPS, BATCH)
 
     # the control: on the tables' splines alone, round 2 is a tie between the two compliances
-    tables_only, _ = diagnose(meas, dense_tables)
+    tables_only = diagnose(meas, dense_tables).to_dict()
     assert tables_only["verdict"]["found_in_order"][0] == "thermal"
     second = tables_only["rounds"][1]["verdict"]
     assert {second["missing_effect"], *second["indistinguishable_from"]} == {"fs_cup_torsion", "cs_housing"}
 
-    diag, _ = diagnose(meas, dense_tables, solve=specimen_solver(UNIT, batch_specimens, SETTINGS, DENSE_STEPS, JOBS))
+    diag = diagnose(meas, dense_tables, solve=specimen_solver(_setup(DENSE_STEPS), batch_specimens)).to_dict()
     assert diag["verdict"]["found_in_order"] == ["thermal", "fs_cup_torsion"]
     assert diag["refinement"]["thermal"]["status"] == "anchored"
     assert diag["rounds"][1]["verdict"]["indistinguishable_from"] == []
@@ -230,7 +238,7 @@ def test_effect_switched_on_for_calibration_comes_first(tmp_path, specimens, tab
     noise = 0.002 * signal
     hidden = {"thermal": {"delta_T_K": 12.0}, "fs_cup_torsion": {"K_Nm_per_rad": 6.0e4}}
     meas = _measure(tmp_path, specimens, hidden, noise)
-    diag, _ = diagnose(meas, tables, calibrate_first=["fs_cup_torsion"])
+    diag = diagnose(meas, tables, Search(calibrate_first=["fs_cup_torsion"])).to_dict()
     assert [f["effect"] for f in diag["found"]][0] == "fs_cup_torsion"
     assert diag["verdict"]["found_in_order"][0] == "thermal"
     assert diag["final"]["effects"]["fs_cup_torsion"]["K_Nm_per_rad"] == pytest.approx(6.0e4, rel=0.15)
@@ -250,7 +258,7 @@ def test_friction_below_what_bench_noise_can_show_is_said(tmp_path, specimens, t
     space cannot show it at that value. (With this seed the search names it all the same,
     mu = 0.0925: 16 % off.)"""
     meas = _measure(tmp_path, specimens, {"tooth_friction": {"mu": 0.08}}, 0.002 * signal)
-    diag, _ = diagnose(meas, tables)
+    diag = diagnose(meas, tables).to_dict()
     row = next(c for c in diag["detectability"]["candidates"] if c["effect"] == "tooth_friction")
     assert not row["visible"] and row["noise_to_show_arcmin"] < 0.002 * signal
     assert row["change_rms_arcmin"] < 0.01
@@ -263,15 +271,12 @@ def test_plan_before_measuring_predicts_what_the_diagnosis_reports(tmp_path, spe
     """`hdwf plan` (detectability from the tables alone, before any measurement) must give the
     same table as the diagnosis of data measured on those specimens at that noise: both see
     the same points, so the same change vectors."""
-    from hdwf.validation.campaign import candidate_names
-    from hdwf.validation.diagnosis import detectability_of_tables
-
     noise = 0.02 * signal
-    plan = detectability_of_tables(tables, UNIT, noise, candidate_names({}))
+    plan = detectability_of_tables(tables, UNIT, noise, candidate_names({})).to_dict()
     assert plan["n_specimens"] == N_SPECIMENS and plan["n_points"] == 21 * N_SPECIMENS
     assert plan["mean_lost_motion_arcmin"] == pytest.approx(signal)
     meas = _measure(tmp_path, specimens, {}, noise)
-    diag, _ = diagnose(meas, tables)
+    diag = diagnose(meas, tables).to_dict()
     got = {c["effect"]: c for c in diag["detectability"]["candidates"]}
     for c in plan["candidates"]:
         d = got[c["effect"]]

@@ -6,7 +6,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from hdwf.validation.measurements import MeasurementError, load_measurements
+from hdwf.study.paper import table3_bounds
+from hdwf.validation.measurements import TABLE3_BOUNDS, MeasurementError, load_measurements
+
+from conftest import DATA
 
 PARAMS = {"d_mm": 31.008, "D_mm": 41.992, "Gr_mm": 0.012, "rFS_mm": 0.01, "rCS_mm": 0.01}
 TORQUES = [0.0, 0.48, 0.96, 0.48, 0.0, -0.48, -0.96, -0.48, 0.0]
@@ -93,3 +96,9 @@ def test_unknown_extension(tmp_path):
     path.write_text("x")
     with pytest.raises(Exception, match="m.xlsx.*csv or .parquet"):
         load_measurements(path)
+
+
+@pytest.mark.parametrize("unit", ["hd42", "hd120"])
+def test_table3_bounds_are_the_papers(unit):
+    """The loader's copy of Table 3 (no data directory needed) is data/paper/table3_bounds.csv."""
+    assert TABLE3_BOUNDS[unit] == table3_bounds(DATA, unit)

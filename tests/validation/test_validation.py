@@ -1,10 +1,19 @@
-"""Comparison statistics and the verdict logic of hdwf.validation.comparison."""
+"""Comparison statistics and the verdict logic of hdwf.validation.comparison; detectability,
+calibration on re-solves (hdwf.validation.calibration) and the report's words on both."""
 
 import numpy as np
 import pandas as pd
 import pytest
 
+from hdwf.report.document import Document
+from hdwf.report.validation_part import detectability_section, refinement_notes
+from hdwf.validation.calibration import (CalibrationData, Resolver, Response, anchor_points, anchored_responses,
+                                         calibrate, refine_fit, responses)
 from hdwf.validation.comparison import Candidate, bic, branches, comparison_points, residual_tests, summarise, verdict
+from hdwf.validation.detectability import detectability
+from hdwf.validation.effects import get
+from hdwf.validation.jsonsafe import json_safe
+from hdwf.validation.variants import plan_variants, variant_key
 
 TORQUES = [0.0, 0.48, 0.96, 0.48, 0.0, -0.48, -0.96, -0.48, 0.0]
 
@@ -64,17 +73,15 @@ def test_verdict_names_the_effect_ties_and_none():
     twin = Candidate("cs_housing", {"k": 1e5}, rss=0.205, n=200, k=1, loo_rmse=0.033)
     weak = Candidate("thermal", {"dT": 1.0}, rss=0.99, n=200, k=1, loo_rmse=0.070)
     v = verdict(base, [weak, twin, strong])
-    assert v["verdict"]["missing_effect"] == "tooth_friction"
-    assert v["verdict"]["indistinguishable_from"] == ["cs_housing"]
-    assert [r["effect"] for r in v["ranking"]] == ["tooth_friction", "cs_housing", "thermal"]
+    assert v.missing_effect == "tooth_friction"
+    assert v.indistinguishable_from == ["cs_housing"]
+    assert [r.effect for r in v.ranking] == ["tooth_friction", "cs_housing", "thermal"]
     none = verdict(base, [weak])
-    assert none["verdict"]["missing_effect"] is None and "no missing effect" in none["verdict"]["text"]
+    assert none.missing_effect is None and "no missing effect" in none.text
 
 
 def _linear_response(g):
     """Flank friction's response made exactly linear in mu: the change at mu is mu * g."""
-    from hdwf.validation.diagnosis import Response
-
     t = np.array([0.0, 0.1, 0.2, 0.3])
     return Response("tooth_friction", "mu", t, t[:, None] * g[None, :], (0.0, 0.3))
 
@@ -83,50 +90,45 @@ def test_detectability_of_a_linear_effect():
     """Change at the realistic mu = 0.08 is 0.08 g; the parameter's relative sd is sigma/|change|
     (linear least squares); at the stated 'noise to show' the effect earns exactly the pay
     threshold, ΔBIC = -10, by the BIC of hdwf.validation.comparison."""
-    from hdwf.validation.diagnosis import detectability
-
     rng = np.random.default_rng(3)
     g = rng.normal(0.0, 1.0, 200)
     resp = {"tooth_friction": _linear_response(g)}
     size = 0.08 * np.linalg.norm(g)
     row, = detectability(resp, noise=0.05, n=200)
-    assert row["change_rms_arcmin"] == pytest.approx(size / np.sqrt(200), rel=1e-9)
-    assert row["expected_rel_sd"] == pytest.approx(0.05 / size, rel=1e-9)
-    s = row["noise_to_show_arcmin"]
+    assert row.change_rms_arcmin == pytest.approx(size / np.sqrt(200), rel=1e-9)
+    assert row.expected_rel_sd == pytest.approx(0.05 / size, rel=1e-9)
+    s = row.noise_to_show_arcmin
     # data holding the effect (RSS n s^2 + |change|^2) against the fitted model (RSS n s^2), one more parameter
     d_bic = bic(200 * s**2, 200, 1) - bic(200 * s**2 + size**2, 200, 0)
     assert d_bic == pytest.approx(-10.0, abs=1e-9)
-    assert row["visible"] == (0.05 < s)
-    assert row["noise_to_calibrate_arcmin"] == pytest.approx(0.075 * size)
+    assert row.visible == (0.05 < s)
+    assert row.noise_to_calibrate_arcmin == pytest.approx(0.075 * size)
     # twice the noise at which it just shows: no longer visible
-    assert detectability(resp, noise=2 * s, n=200)[0]["visible"] is False
+    assert detectability(resp, noise=2 * s, n=200)[0].visible is False
 
 
 def test_report_says_which_effects_the_data_could_not_show():
     """The report's table and sentence come from diagnosis.json: a candidate the data could not
     show is named with the noise it needs; a perfect fit (noise 0: sd null in the JSON) prints
     a dash, not an error; a found effect is not listed as unseen."""
-    from hdwf.validation.diagnosis import detectability, json_safe
-    from hdwf.report.document import Document, _detectability_part
-
     g = np.linspace(-1.0, 1.0, 100)
     resp = {"tooth_friction": _linear_response(g)}
-    rows = json_safe(detectability(resp, noise=1.0, n=100))
+    rows = json_safe([r.as_dict() for r in detectability(resp, noise=1.0, n=100)])
     diag = {"noise_arcmin": 1.0, "verdict": {"could_not_see": ["tooth_friction"]},
             "detectability": {"noise_arcmin": 1.0, "noise_from": "stated", "candidates": rows}}
     doc = Document("t", "s", {})
-    _detectability_part(doc, diag, 2)
+    detectability_section(doc, diag, 2)
     table = next(b for b in doc.blocks if b["type"] == "table")
     assert table["rows"][0][-1] == "no"
     sentence = doc.blocks[-1]["text"]
     assert "Coulomb friction on the tooth flanks" in sentence
     assert f"needs noise below {rows[0]['noise_to_show_arcmin']:.2f}" in sentence
-    rows0 = json_safe(detectability(resp, noise=0.0, n=100))
+    rows0 = json_safe([r.as_dict() for r in detectability(resp, noise=0.0, n=100)])
     assert rows0[0]["expected_delta_bic"] is None and rows0[0]["visible"] is True
     diag0 = {"noise_arcmin": 0.0, "verdict": {"could_not_see": []},
              "detectability": {"noise_arcmin": 0.0, "noise_from": "stated", "candidates": rows0}}
     doc0 = Document("t", "s", {})
-    _detectability_part(doc0, diag0, 2)
+    detectability_section(doc0, diag0, 2)
     assert doc0.blocks[-1]["type"] == "table" and doc0.blocks[-1]["rows"][0][-1] == "yes"
 
 
@@ -135,8 +137,6 @@ def _kinked_thermal(n_points=60, seed=5):
     one): twist_i(dT) = base_i - g_i max(dT - k_i, 0), g_i > 0 (the dead band shrinks), kinks
     k_i in 11..14 or 20..23 K (straight in between); and a ``solve`` that returns it exactly for
     any variant, counting its calls."""
-    from hdwf.validation.campaign import plan_variants, variant_key
-
     rng = np.random.default_rng(seed)
     g = rng.uniform(0.01, 0.03, n_points)
     k = np.where(np.arange(n_points) % 2 == 0, rng.uniform(11, 14, n_points), rng.uniform(20, 23, n_points))
@@ -166,23 +166,20 @@ def test_anchoring_on_actual_solves_removes_the_tables_interpolation_error():
     around its estimate (three, in one call), the response is exact there (straight between
     the kinks, so the quadratic through the three is exact) and the calibration recovers
     17 K; the log says where it solved."""
-    from hdwf.validation.diagnosis import calibrate, refine_fit, responses
-
     table, obs, twist, solve, calls = _kinked_thermal()
     resp = responses(table, obs, {}, ["thermal"])
-    S0 = twist({})
-    D = twist({"thermal": {"delta_T_K": 17.0}})
-    plain = calibrate(D, S0, resp, ["thermal"])
+    data = CalibrationData(twist({"thermal": {"delta_T_K": 17.0}}), twist({}), resp)
+    plain = calibrate(data, ["thermal"])
     assert abs(plain.t[0] - 17.0) > 0.1           # the spline's error shows in the estimate (0.19 K)
     log = {}
-    fit = refine_fit(D, S0, resp, dict(resp), plain, solve, obs, {}, log, before_round=2)
+    fit = refine_fit(data, plain, Resolver(solve, obs, {}, dict(resp)), log, before_round=2)
     assert fit.t[0] == pytest.approx(17.0, abs=1e-6)
     assert fit.rss == pytest.approx(0.0, abs=1e-16)
     assert calls == [3]
     lo, hi = resp["thermal"].anchor[0][[0, -1]]
     assert lo <= 17.0 <= hi and hi - lo == pytest.approx(2.0)     # ± a tenth of the 10 K spacing
-    assert log["thermal"]["status"] == "anchored" and log["thermal"]["before_round"] == 2
-    assert log["thermal"]["solved_at"] == pytest.approx([lo, (lo + hi) / 2, hi])
+    assert log["thermal"].status == "anchored" and log["thermal"].before_round == 2
+    assert log["thermal"].solved_at == pytest.approx([lo, (lo + hi) / 2, hi])
 
 
 def test_an_anchored_response_is_exact_at_the_grid_and_off_at_zero():
@@ -190,11 +187,9 @@ def test_an_anchored_response_is_exact_at_the_grid_and_off_at_zero():
     the solves, the shift fading to zero at the next grid value: it stays continuous at the
     interval's ends and equals the table (an actual solve) at every grid value, so t = 0
     still means "off"."""
-    from hdwf.validation.diagnosis import anchored_responses, responses
-
     table, obs, twist, solve, _ = _kinked_thermal()
     resp = responses(table, obs, {}, ["thermal"])["thermal"]
-    anchored = anchored_responses({"thermal": resp}, {"thermal": 16.3}, solve, obs, {})["thermal"]
+    anchored = anchored_responses(Resolver(solve, obs, {}, {"thermal": resp}), {"thermal": 16.3})["thermal"]
     for t in resp.t:                                   # the grid, incl. 0 and the bounds
         np.testing.assert_allclose(anchored.change(t), resp.change(t), atol=1e-12)
     np.testing.assert_allclose(anchored.change(0.0), 0.0, atol=1e-12)
@@ -207,8 +202,6 @@ def test_an_anchored_response_is_exact_at_the_grid_and_off_at_zero():
 def test_a_failed_anchor_solve_keeps_the_table_and_says_so():
     """A solve that raises, or returns a failed status, must not lose the diagnosis: the
     table's response is kept, the estimate is the table's, and the log names the failure."""
-    from hdwf.validation.diagnosis import calibrate, refine_fit, responses
-
     table, obs, twist, solve, _ = _kinked_thermal()
     S0, D = twist({}), twist({"thermal": {"delta_T_K": 17.0}})
 
@@ -222,21 +215,19 @@ def test_a_failed_anchor_solve_keeps_the_table_and_says_so():
 
     for bad, reason in ((crashes, "RuntimeError: worker died"), (fails, "failed: no convergence")):
         resp = responses(table, obs, {}, ["thermal"])
-        plain = calibrate(D, S0, resp, ["thermal"])
+        data = CalibrationData(D, S0, resp)
+        plain = calibrate(data, ["thermal"])
         log = {}
-        fit = refine_fit(D, S0, resp, dict(resp), plain, bad, obs, {}, log, before_round=2)
+        fit = refine_fit(data, plain, Resolver(bad, obs, {}, dict(resp)), log, before_round=2)
         assert fit.t[0] == plain.t[0] and resp["thermal"].anchor is None
-        assert log["thermal"]["status"] == "failed" and reason in log["thermal"]["reason"]
-        assert "the table's response is used" in log["thermal"]["reason"]
+        assert log["thermal"].status == "failed" and reason in log["thermal"].reason
+        assert "the table's response is used" in log["thermal"].reason
 
 
 def test_anchor_points_of_a_stiffness_stay_inside_its_values():
     """Housing stiffness is tabulated in t = k^-3/4, where t = 0 ("off", k infinite) is not
     a value: an estimate at or near 0 is solved at three finite stiffnesses within the
     parameter's bounds, in increasing t, a tenth of the grid spacing apart."""
-    from hdwf.validation.diagnosis import Response, anchor_points
-    from hdwf.validation.effects import get
-
     p = get("cs_housing").param("k_N_per_mm2")
     lo, hi = p.t_bounds
     resp = Response("cs_housing", p.name, np.array([lo, hi]), np.zeros((2, 1)), (lo, hi))
@@ -250,15 +241,13 @@ def test_anchor_points_of_a_stiffness_stay_inside_its_values():
 def test_report_says_where_an_effect_was_re_solved():
     """diagnosis.json's ``refinement`` in words: the values solved at, and a caution when a
     solve failed (the sentence must not claim a recalibration that did not happen)."""
-    from hdwf.report.document import Document, _refinement_part
-
     diag = {"refinement": {
         "thermal": {"status": "anchored", "before_round": 2, "param": "delta_T_K",
                     "solved_at": [10.1468, 11.1468, 12.1468], "solves": 1},
         "cs_housing": {"status": "failed", "reason": "the solve failed (failed: no convergence); "
                                                     "the table's response is used"}}}
     doc = Document("t", "s", {})
-    _refinement_part(doc, diag)
+    refinement_notes(doc, diag)
     texts = [b["text"] for b in doc.blocks]
     assert len(texts) == 2
     assert "Before round 2" in texts[0] and "10.1468, 11.1468, 12.1468" in texts[0]

@@ -1,8 +1,6 @@
 """The shipped measurement files and the campaign settings of config.yaml."""
 
-from pathlib import Path
 
-import pandas as pd
 import pytest
 import yaml
 

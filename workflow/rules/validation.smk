@@ -4,42 +4,26 @@
 # the model with the found effects switched on; figures for the report.
 
 import dataclasses
-import re
 
-from hdwf.validation.campaign import campaign_plan
-from hdwf.common.errors import InputError
-from hdwf.validation.measurements import load_measurements
+from hdwf.stages.validation import campaign_plan, campaign_specimens, specimen_record
 
 CAMPAIGNS = {name: campaign_plan(name, c, FE) for name, c in config.get("validation", {}).items()}
 _SPECIMENS = {}
 
 
-def campaign_specimens(campaign):
+def specimens_of(campaign):
     """The campaign's specimens, read (and checked) once from its measurement file."""
     if campaign not in _SPECIMENS:
-        plan = CAMPAIGNS[campaign]
-        meas = load_measurements(plan.measurements)   # every problem with file, row and field
-        spec = meas.specimens
-        for i, r in spec.iterrows():
-            if r["unit"] != plan.unit:
-                raise InputError(plan.measurements, f"campaign '{campaign}' is for {plan.unit}",
-                                 field="unit", value=r["unit"], row=int(i) + 1)
-            if not re.fullmatch(r"[A-Za-z0-9_.\-]+", str(r["specimen_id"])):
-                raise InputError(plan.measurements, "specimen ids may use letters, digits, '_', '.' and '-' only",
-                                 field="specimen_id", value=r["specimen_id"], row=int(i) + 1)
-        _SPECIMENS[campaign] = spec
+        _SPECIMENS[campaign] = campaign_specimens(CAMPAIGNS[campaign])
     return _SPECIMENS[campaign]
 
 
 def specimen_ids(campaign):
-    return list(campaign_specimens(campaign)["specimen_id"])
+    return list(specimens_of(campaign)["specimen_id"])
 
 
 def specimen_row(w):
-    spec = campaign_specimens(w.campaign)
-    row = spec[spec["specimen_id"] == w.specimen].iloc[0]
-    return {k: (float(v) if k.endswith("_mm") else str(v)) for k, v in row.items()
-            if k in ("specimen_id", "unit") or k.endswith("_mm")}
+    return specimen_record(specimens_of(w.campaign), w.specimen)
 
 
 def plan_dict(w):
@@ -62,7 +46,6 @@ rule validation_specimen:
         settings=lambda w: CAMPAIGNS[w.campaign].settings,
         steps_per_ramp=lambda w: CAMPAIGNS[w.campaign].steps_per_ramp,
         variants=lambda w: CAMPAIGNS[w.campaign].table_variants(),
-        repo=REPO_DIR,
     threads: 1
     resources:
         mem_mb=4000,
@@ -85,7 +68,6 @@ rule validation_diagnosis:
         points="results/validation/{campaign}/points.parquet",
     params:
         plan=plan_dict,
-        repo=REPO_DIR,
     # an effect found before the next round is re-solved near its estimate, every specimen
     threads: 2
     resources:
@@ -112,7 +94,6 @@ rule validation_ladder:
         unit=lambda w: CAMPAIGNS[w.campaign].unit,
         settings=lambda w: CAMPAIGNS[w.campaign].settings,
         steps_per_ramp=lambda w: CAMPAIGNS[w.campaign].steps_per_ramp,
-        repo=REPO_DIR,
     threads: 2
     resources:
         mem_mb=4000,
@@ -133,8 +114,6 @@ rule validation_figures:
         measured="results/validation/{campaign}/measured_vs_predicted.png",
         residuals="results/validation/{campaign}/residuals.png",
         ladder="results/validation/{campaign}/ladder.png",
-    params:
-        repo=REPO_DIR,
     log:
         "results/logs/validation_{campaign}_figures.log",
     script:

@@ -1,16 +1,16 @@
-"""Adapter for rule validation_diagnosis: calibrate and rank the candidate effects."""
-import logging, sys
-sys.path.insert(0, __import__("os").path.dirname(__file__))
-from _adapter import setup  # noqa: E402
+"""Rule validation_diagnosis: calibrate and rank the candidate effects."""
+import logging
 
-from hdwf.validation.campaign import CampaignPlan  # noqa: E402
-from hdwf.validation.diagnosis import diagnosis_stage  # noqa: E402
+from _helpers import mock_snakemake, setup
+
+from hdwf.stages.validation import CampaignInputs, CampaignPlan, diagnosis_stage
 
 # guarded: the re-solves before a further round run in spawned processes, which import this file
 if __name__ == "__main__":
-    prov = setup(snakemake)  # noqa: F821
-    plan = CampaignPlan(**snakemake.params.plan)  # noqa: F821
-    result = diagnosis_stage(snakemake.input.measurements, snakemake.input.tables, plan,  # noqa: F821
-                             snakemake.output.json, snakemake.output.points, prov,  # noqa: F821
-                             jobs=snakemake.threads)  # noqa: F821
+    if "snakemake" not in globals():  # run outside Snakemake, from the project root
+        snakemake = mock_snakemake("validation_diagnosis", campaign="demo")
+    prov = setup(snakemake)
+    result = diagnosis_stage(CampaignPlan(**snakemake.params.plan),
+                             CampaignInputs(snakemake.input.measurements, list(snakemake.input.tables)),
+                             snakemake.output.json, snakemake.output.points, prov, jobs=snakemake.threads)
     logging.info("verdict: %s", result["verdict"])

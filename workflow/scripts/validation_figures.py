@@ -1,17 +1,11 @@
-"""Adapter for rule validation_figures: measured vs predicted, residuals, the ladder."""
-import json, sys
-sys.path.insert(0, __import__("os").path.dirname(__file__))
-from _adapter import setup  # noqa: E402
+"""Rule validation_figures: measured vs predicted, residuals, the ladder."""
+from _helpers import mock_snakemake, setup
 
-import pandas as pd  # noqa: E402
+from hdwf.stages.validation import figures_stage
 
-from hdwf.report.figures import ladder_figure, measured_vs_predicted_figure, residual_figure  # noqa: E402
+if "snakemake" not in globals():  # run outside Snakemake, from the project root
+    snakemake = mock_snakemake("validation_figures", campaign="demo")
 
-setup(snakemake)  # noqa: F821
-inp, out = snakemake.input, snakemake.output  # noqa: F821
-diag = json.loads(open(inp.diagnosis).read())
-points = pd.read_parquet(inp.points)
-name = f"{diag['campaign']} ({diag['unit'].upper()})"
-measured_vs_predicted_figure(points, f"{name}: measured against predicted", out.measured)
-residual_figure(points, f"{name}: residuals", out.residuals)
-ladder_figure(pd.read_parquet(inp.ladder), diag.get("noise_arcmin"), f"{name}: the error ladder", out.ladder)
+setup(snakemake)
+inp, out = snakemake.input, snakemake.output
+figures_stage(inp.diagnosis, inp.points, inp.ladder, out.measured, out.residuals, out.ladder)

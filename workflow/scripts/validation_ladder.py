@@ -1,16 +1,19 @@
-"""Adapter for rule validation_ladder: the ladder's variants solved where the tables lack them,
-then RMSE, bias and ΔBIC of every rung."""
-import logging, sys
-sys.path.insert(0, __import__("os").path.dirname(__file__))
-from _adapter import setup  # noqa: E402
+"""Rule validation_ladder: the ladder's variants solved where the tables lack them, then RMSE,
+bias and ΔBIC of every rung."""
+import logging
 
-from hdwf.validation.diagnosis import ladder_stage  # noqa: E402
+from _helpers import mock_snakemake, setup
+
+from hdwf.stages.validation import CampaignInputs, ladder_stage
+from hdwf.validation.variants import SolveSetup
 
 # guarded: the solves run in spawned processes, which import this file
 if __name__ == "__main__":
-    prov = setup(snakemake)  # noqa: F821
-    p = snakemake.params  # noqa: F821
-    ladder = ladder_stage(snakemake.input.measurements, snakemake.input.diagnosis,  # noqa: F821
-                          snakemake.input.tables, snakemake.output[0], prov, p.unit,  # noqa: F821
-                          dict(p.settings), p.steps_per_ramp, jobs=snakemake.threads)  # noqa: F821
+    if "snakemake" not in globals():  # run outside Snakemake, from the project root
+        snakemake = mock_snakemake("validation_ladder", campaign="demo")
+    prov = setup(snakemake)
+    p = snakemake.params
+    ladder = ladder_stage(SolveSetup(p.unit, dict(p.settings), p.steps_per_ramp, snakemake.threads),
+                          CampaignInputs(snakemake.input.measurements, list(snakemake.input.tables)),
+                          snakemake.input.diagnosis, snakemake.output[0], prov)
     logging.info("\n%s", ladder.to_string())

@@ -1,11 +1,16 @@
-"""Adapter for rule validation_specimen: one specimen, every variant of its campaign's table."""
-import logging, sys
-sys.path.insert(0, __import__("os").path.dirname(__file__))
-from _adapter import setup  # noqa: E402
+"""Rule validation_specimen: one specimen, every variant of its campaign's table."""
+import logging
 
-from hdwf.validation.campaign import specimen_stage  # noqa: E402
+from _helpers import mock_snakemake, setup
 
-prov = setup(snakemake)  # noqa: F821
-p = snakemake.params  # noqa: F821
-table = specimen_stage(p.unit, p.specimen, p.settings, p.steps_per_ramp, p.variants, snakemake.output[0], prov)  # noqa: F821
+from hdwf.stages.validation import specimen_stage
+from hdwf.validation.variants import SolveSetup
+
+if "snakemake" not in globals():  # run outside Snakemake, from the project root
+    snakemake = mock_snakemake("validation_specimen", campaign="demo", specimen="hd42-s001")
+
+prov = setup(snakemake)
+p = snakemake.params
+table = specimen_stage(SolveSetup(p.unit, p.settings, p.steps_per_ramp), p.specimen, p.variants,
+                       snakemake.output[0], prov)
 logging.info("%d variants, statuses %s", table["variant"].nunique(), table["status"].value_counts().to_dict())

@@ -3,7 +3,6 @@ deformed mesh) and of the validation campaigns, each written atomically as a PNG
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import matplotlib
 import matplotlib.pyplot as plt

@@ -10,10 +10,12 @@ error on torque and load branch (where along the curve does the model fail?).
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
+import statsmodels.api as sm
+from statsmodels.stats.diagnostic import linear_reset
 
 from hdwf import PARAMETER_COLUMNS
 
@@ -25,6 +27,16 @@ def branches(torque: np.ndarray) -> list[str]:
 
     A point belongs to the branch it was reached on: |T| rising gives ``load±``, falling
     ``unload±``; the sign is that of the torque (zero-torque points take the branch they end).
+
+    Parameters
+    ----------
+    torque : array_like
+        The torque of each point, in test order.
+
+    Returns
+    -------
+    list of str
+        ``load+``, ``unload+``, ``load-`` or ``unload-`` per point.
     """
     t = np.asarray(torque, float)
     out, prev, sign = [], 0.0, 1.0
@@ -41,8 +53,20 @@ def comparison_points(measured: pd.DataFrame, predicted: pd.DataFrame, value: st
     """Join measured and predicted values point by point.
 
     Both frames carry ``specimen_id`` and, for curves, ``step``; ``value`` names the compared
-    column (``twist_arcmin`` or ``lost_motion_arcmin``...). Returns D, S, E = S − D and u_D
-    (from ``u_twist_arcmin`` / ``u_arcmin`` when the data give it, else NaN).
+    column (``twist_arcmin`` or ``lost_motion_arcmin``...).
+
+    Parameters
+    ----------
+    measured, predicted : pandas.DataFrame
+        Measured and predicted values, keyed by ``specimen_id`` (and ``step``).
+    value : str
+        The compared column.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The measured rows with D, S, E = S − D and u_D (from ``u_twist_arcmin`` / ``u_arcmin``
+        when the data give it, else NaN); curves also get their ``branch``.
     """
     keys = ["specimen_id"] + (["step"] if "step" in measured.columns and "step" in predicted.columns else [])
     u_col = next((c for c in ("u_twist_arcmin", "u_arcmin") if c in measured.columns), None)
@@ -64,6 +88,8 @@ def comparison_points(measured: pd.DataFrame, predicted: pd.DataFrame, value: st
 
 @dataclass(frozen=True)
 class Summary:
+    """Overall figures of a comparison (arcmin)."""
+
     n: int
     rmse: float
     bias: float
@@ -74,7 +100,20 @@ class Summary:
 
 
 def summarise(points: pd.DataFrame, u_num: float = 0.0, u_input: float = 0.0) -> tuple[Summary, pd.DataFrame]:
-    """Overall figures and one row per specimen (rmse, bias, largest |E|)."""
+    """Overall figures and one row per specimen (rmse, bias, largest |E|).
+
+    Parameters
+    ----------
+    points : pandas.DataFrame
+        Comparison points (``comparison_points``).
+    u_num, u_input : float
+        Numerical and input uncertainty (arcmin) of the simulation, for u_val.
+
+    Returns
+    -------
+    tuple
+        The ``Summary`` and a frame of the specimens, worst first.
+    """
     E = points["E"].to_numpy(float)
     per = points.groupby("specimen_id", sort=False)["E"].agg(
         rmse_arcmin=lambda e: float(np.sqrt(np.mean(np.square(e)))), bias_arcmin="mean",
@@ -91,12 +130,18 @@ def summarise(points: pd.DataFrame, u_num: float = 0.0, u_input: float = 0.0) ->
 
 
 def residual_tests(points: pd.DataFrame) -> pd.DataFrame:
-    """statsmodels tests on the comparison error, with p-values (small p: a pattern the model misses)."""
-    # imported here: statsmodels takes a second to import, and the per-specimen jobs that
-    # import this module never run the tests
-    import statsmodels.api as sm
-    from statsmodels.stats.diagnostic import linear_reset
+    """statsmodels tests on the comparison error, with p-values (small p: a pattern the model misses).
 
+    Parameters
+    ----------
+    points : pandas.DataFrame
+        Comparison points (``comparison_points``) with the parameter columns.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per test: ``test``, ``statistic``, ``p_value``, ``meaning``.
+    """
     rows = []
     spec = points.groupby("specimen_id", sort=False).agg(E=("E", "mean"), **{c: (c, "first") for c in PARAMETER_COLUMNS})
     X = spec[list(PARAMETER_COLUMNS)].to_numpy(float)
@@ -123,12 +168,27 @@ def residual_tests(points: pd.DataFrame) -> pd.DataFrame:
 
 
 def bic(rss: float, n: int, k: int) -> float:
-    """Bayesian information criterion of a Gaussian least-squares fit with k free parameters."""
+    """Bayesian information criterion of a Gaussian least-squares fit.
+
+    Parameters
+    ----------
+    rss : float
+        Residual sum of squares.
+    n, k : int
+        Number of observations and of free parameters.
+
+    Returns
+    -------
+    float
+        n ln(RSS/n) + k ln n.
+    """
     return n * np.log(max(rss, 1e-300) / n) + k * np.log(n)
 
 
 @dataclass(frozen=True)
 class Candidate:
+    """A model calibrated to the data: the current model or the current model plus one effect."""
+
     effect: str
     params: dict
     rss: float
@@ -138,37 +198,71 @@ class Candidate:
 
     @property
     def rmse(self) -> float:
+        """Root-mean-square error of the fit (arcmin)."""
         return float(np.sqrt(self.rss / self.n))
 
 
+@dataclass
+class Ranked:
+    """One candidate's row of a ranking: its fit and ΔBIC against the current model."""
+
+    effect: str
+    params: dict
+    rmse_arcmin: float
+    delta_bic: float
+    loo_rmse_arcmin: float
+    pays: bool
+
+
+@dataclass
+class Verdict:
+    """The candidates ranked by ΔBIC and the decision."""
+
+    ranking: list[Ranked]
+    missing_effect: str | None          # the paying candidate of lowest BIC, None when none pays
+    indistinguishable_from: list[str]   # paying candidates within the tie threshold of it
+    text: str
+
+    def decision(self) -> dict:
+        """The decision as ``diagnosis.json`` gives it (``missing_effect``, ``indistinguishable_from``, ``text``)."""
+        return {"missing_effect": self.missing_effect, "indistinguishable_from": self.indistinguishable_from,
+                "text": self.text}
+
+
 def verdict(baseline: Candidate, candidates: list[Candidate], pay_threshold: float = 10.0,
-            tie_threshold: float = 6.0) -> dict:
+            tie_threshold: float = 6.0) -> Verdict:
     """Rank candidates by ΔBIC against the baseline and decide.
 
     A candidate *pays* when ΔBIC ≤ −``pay_threshold`` (10: very strong evidence, Kass &
     Raftery 1995) and its leave-one-out error is below the baseline's. The missing effect
     is the paying candidate of lowest BIC; paying candidates within ``tie_threshold`` of it
     (less than strong evidence to prefer it) are reported as indistinguishable.
+
+    Parameters
+    ----------
+    baseline : Candidate
+        The current model.
+    candidates : list of Candidate
+        The current model plus each candidate effect, calibrated.
+    pay_threshold, tie_threshold : float
+        ΔBIC a candidate must earn, and the gap below which two paying ones are a tie.
+
+    Returns
+    -------
+    Verdict
+        The ranking (lowest ΔBIC first) and the decision.
     """
     b0 = bic(baseline.rss, baseline.n, baseline.k)
     ranking = []
     for c in candidates:
         d = bic(c.rss, c.n, c.k) - b0
-        ranking.append({"effect": c.effect, "params": c.params, "rmse_arcmin": c.rmse, "delta_bic": float(d),
-                        "loo_rmse_arcmin": c.loo_rmse,
-                        "pays": bool(d <= -pay_threshold and c.loo_rmse < baseline.loo_rmse)})
-    ranking.sort(key=lambda r: r["delta_bic"])
-    paying = [r for r in ranking if r["pays"]]
+        ranking.append(Ranked(c.effect, c.params, c.rmse, float(d), c.loo_rmse,
+                              bool(d <= -pay_threshold and c.loo_rmse < baseline.loo_rmse)))
+    ranking.sort(key=lambda r: r.delta_bic)
+    paying = [r for r in ranking if r.pays]
     if not paying:
-        return {"baseline": {"rmse_arcmin": baseline.rmse, "loo_rmse_arcmin": baseline.loo_rmse},
-                "ranking": ranking, "verdict": {"missing_effect": None, "indistinguishable_from": [],
-                                                "text": "no missing effect found"}}
+        return Verdict(ranking, None, [], "no missing effect found")
     best = paying[0]
-    ties = [r["effect"] for r in paying[1:] if r["delta_bic"] - best["delta_bic"] < tie_threshold]
-    text = f"{best['effect']} is missing" + (f"; the data cannot tell it from {', '.join(ties)}" if ties else "")
-    return {"baseline": {"rmse_arcmin": baseline.rmse, "loo_rmse_arcmin": baseline.loo_rmse}, "ranking": ranking,
-            "verdict": {"missing_effect": best["effect"], "indistinguishable_from": ties, "text": text}}
-
-
-def summary_dict(summary: Summary) -> dict:
-    return asdict(summary)
+    ties = [r.effect for r in paying[1:] if r.delta_bic - best.delta_bic < tie_threshold]
+    text = f"{best.effect} is missing" + (f"; the data cannot tell it from {', '.join(ties)}" if ties else "")
+    return Verdict(ranking, best.effect, ties, text)

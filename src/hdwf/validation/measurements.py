@@ -39,8 +39,10 @@ _WRONG_UNITS = {
     "twist": ("twist_arcmin", ["twist_deg", "twist_rad", "twist_arcsec", "twist_mrad", "twist_urad", "twist"]),
     "lost_motion": ("lost_motion_arcmin", ["lost_motion_deg", "lost_motion_arcsec", "lost_motion_rad"]),
 }
-# Table 3 bounds of each drive; the model is supported one span beyond them on each side,
-# and never for negative clearance or offsets (interference is outside the model's assumptions).
+# Table 3 bounds of each drive (mm). The same numbers as data/paper/table3_bounds.csv, which
+# ``hdwf.study.paper.table3_bounds(data_dir, unit)`` reads: kept here so that checking a
+# measurement file or synthesising one needs no data directory (tests/validation/
+# test_measurements.py checks that the two agree).
 TABLE3_BOUNDS = {
     "hd42": {"d": (31.0, 31.016), "D": (41.984, 42.0), "Gr": (0.005, 0.02), "rFS": (0.0, 0.02), "rCS": (0.0, 0.02)},
     "hd120": {"d": (90.0, 90.022), "D": (119.978, 120.0), "Gr": (0.0, 0.055), "rFS": (0.025, 0.055),
@@ -49,11 +51,30 @@ TABLE3_BOUNDS = {
 
 
 def lost_motion_test_torque_Nm(unit: str) -> float:
-    """The test torque, 4 % of T_N, from the drive table of ``hdwf.drive.geometry``."""
+    """The test torque of drive ``unit`` (``"hd42"`` or ``"hd120"``).
+
+    Returns
+    -------
+    float
+        4 % of T_N (N·m), from the drive table of ``hdwf.drive.geometry``.
+    """
     return unit_data(unit).torque_Nmm / 1000.0
 
 
 def supported_bounds(unit: str) -> dict[str, tuple[float, float]]:
+    """Where the model is supported: one Table 3 span beyond its bounds on each side, and never
+    at negative clearance or offsets (interference is outside the model's assumptions).
+
+    Parameters
+    ----------
+    unit : str
+        The drive.
+
+    Returns
+    -------
+    dict
+        ``{parameter: (low, high)}`` in mm, by parameter name (``"d"`` … ``"rCS"``).
+    """
     out = {}
     for p, (lo, hi) in TABLE3_BOUNDS[unit].items():
         span = hi - lo
@@ -85,6 +106,7 @@ class Measurements:
 
     @property
     def units(self) -> list[str]:
+        """The drives of its specimens, sorted."""
         return sorted(self.specimens["unit"].unique())
 
 
@@ -105,14 +127,46 @@ def _form_of(columns) -> str | None:
 
 
 def load_measurements(path: str | Path) -> Measurements:
-    """Read and check a measurement file; raise MeasurementError listing every problem."""
+    """Read and check a measurement file.
+
+    Parameters
+    ----------
+    path : str or Path
+        A ``.csv`` or ``.parquet`` file in one of the documented forms.
+
+    Returns
+    -------
+    Measurements
+        The checked rows and one row per specimen.
+
+    Raises
+    ------
+    InputError
+        When the file is missing or of an unknown type.
+    MeasurementError
+        Listing every problem found, each with row and field.
+    """
     path = Path(path)
     if not path.exists():
         raise InputError(path, "file not found")
     raw = _read_raw(path)
-    problems: list[tuple] = []
-    cols = list(raw.columns)
+    form, problems = _header_problems(list(raw.columns))
+    if problems:
+        raise MeasurementError(path, problems)
+    if len(raw) == 0:
+        raise MeasurementError(path, [(None, None, None, "no data rows")])
+    data, problems = _typed_data(raw, form)
+    problems += _value_problems(data, form)
+    problems += _check_specimens(data, form)
+    if problems:
+        raise MeasurementError(path, sorted(problems, key=lambda p: (p[0] or 0)))
+    specimens = _specimen_table(data, form)
+    return Measurements(path=path, form=form, data=data, specimens=specimens)
 
+
+def _header_problems(cols: list[str]) -> tuple[str | None, list[tuple]]:
+    """The form the columns give, and what is wrong with them (wrong units, missing columns)."""
+    problems = []
     for quantity, (right, wrongs) in _WRONG_UNITS.items():
         for w in wrongs:
             if w in cols and right not in cols:
@@ -125,14 +179,15 @@ def load_measurements(path: str | Path) -> Measurements:
     for c in ID_COLUMNS:
         if c not in cols:
             problems.append((None, c, None, "missing column"))
-    if problems:
-        raise MeasurementError(path, problems)
-    if len(raw) == 0:
-        raise MeasurementError(path, [(None, None, None, "no data rows")])
+    return form, problems
 
+
+def _typed_data(raw: pd.DataFrame, form: str) -> tuple[pd.DataFrame, list[tuple]]:
+    """The rows with typed columns, and every value that is not a number, an id or a drive."""
+    problems = []
     numeric = list(PARAMETER_COLUMNS) + FORMS[form]
     ucol = UNCERTAINTY_COLUMN[form]
-    if ucol in cols:
+    if ucol in raw.columns:
         numeric.append(ucol)
     data = pd.DataFrame({"specimen_id": raw["specimen_id"].astype(str).str.strip(),
                          "unit": raw["unit"].astype(str).str.strip().str.lower().str.replace(" ", "")})
@@ -145,7 +200,12 @@ def load_measurements(path: str | Path) -> Measurements:
         problems.append((i + 1, "specimen_id", "", "empty specimen id"))
     for i in np.flatnonzero(~data["unit"].isin(UNITS).to_numpy()):
         problems.append((i + 1, "unit", raw["unit"].iloc[i], f"unknown drive; the model knows {list(UNITS)}"))
+    return data, problems
 
+
+def _value_problems(data: pd.DataFrame, form: str) -> list[tuple]:
+    """Parameters outside the model's support and negative uncertainties."""
+    problems = []
     for i, row in data.iterrows():
         if row["unit"] not in UNITS:
             continue
@@ -154,15 +214,11 @@ def load_measurements(path: str | Path) -> Measurements:
             v = row[c]
             if np.isfinite(v) and not lo - 1e-12 <= v <= hi + 1e-12:
                 problems.append((i + 1, c, v, f"outside what the model supports for {row['unit']}: [{lo:g}, {hi:g}] mm"))
+    ucol = UNCERTAINTY_COLUMN[form]
     if ucol in data:
         for i in np.flatnonzero((data[ucol] < 0).to_numpy()):
             problems.append((i + 1, ucol, data[ucol].iloc[i], "an uncertainty cannot be negative"))
-
-    problems += _check_specimens(data, form)
-    if problems:
-        raise MeasurementError(path, sorted(problems, key=lambda p: (p[0] or 0)))
-    specimens = _specimen_table(data, form)
-    return Measurements(path=path, form=form, data=data, specimens=specimens)
+    return problems
 
 
 def _check_specimens(data: pd.DataFrame, form: str) -> list[tuple]:

@@ -27,6 +27,8 @@ from hdwf.fe import ModelChanges
 
 @dataclass(frozen=True)
 class Parameter:
+    """One parameter of an effect: its range, realistic value and calibration transform."""
+
     name: str
     unit: str
     lower: float
@@ -43,9 +45,11 @@ class Parameter:
         return dict(self.realistic_by_unit).get(unit, self.realistic)
 
     def to_t(self, value: float) -> float:
+        """The transformed parameter t of a value (0 = off)."""
         return float(value) ** -self.power if self.transform == "reciprocal" else float(value)
 
     def from_t(self, t: float) -> float:
+        """The value at t (``to_t`` inverted)."""
         if self.transform == "reciprocal":
             return math.inf if t == 0 else float(t) ** (-1.0 / self.power)
         return float(t)
@@ -58,6 +62,7 @@ class Parameter:
 
     @property
     def t_bounds(self) -> tuple[float, float]:
+        """The range of t, widened to include 0 (off)."""
         a, b = self.to_t(self.lower), self.to_t(self.upper)
         lo, hi = min(a, b), max(a, b)
         return (min(lo, 0.0), max(hi, 0.0))
@@ -75,6 +80,7 @@ class Parameter:
         return [self.clip(self.from_t(t)) for t in ts if t != 0.0]
 
     def check(self, value: float, where: str) -> float:
+        """``value`` as a float; a ValueError naming ``where`` when it is outside the bounds."""
         v = float(value)
         if not (self.lower <= v <= self.upper):
             raise ValueError(f"{where}: {self.name} = {value!r} {self.unit} is outside "
@@ -84,6 +90,9 @@ class Parameter:
 
 @dataclass(frozen=True)
 class Effect:
+    """A candidate physical effect: what it is, its signature, its parameters and how it changes
+    the FE model."""
+
     name: str
     title: str
     description: str
@@ -95,6 +104,7 @@ class Effect:
     off: dict = field(default_factory=dict)   # parameter values that switch it off
 
     def param(self, name: str) -> Parameter:
+        """The parameter called ``name``."""
         for p in self.parameters:
             if p.name == name:
                 return p
@@ -103,7 +113,13 @@ class Effect:
 
 
 def registry() -> dict[str, Effect]:
-    """Every effect module of this package, by name (imported on first use)."""
+    """Every effect module of this package, by name (imported on first use).
+
+    Returns
+    -------
+    dict
+        ``{name: Effect}``, in the order of the modules' names.
+    """
     out: dict[str, Effect] = {}
     for info in sorted(pkgutil.iter_modules(__path__), key=lambda i: i.name):
         if info.name.startswith("_"):
@@ -119,6 +135,18 @@ def registry() -> dict[str, Effect]:
 
 
 def get(name: str) -> Effect:
+    """One effect of the registry.
+
+    Parameters
+    ----------
+    name : str
+        The effect's name.
+
+    Returns
+    -------
+    Effect
+        The effect; a KeyError listing the known ones when there is none of that name.
+    """
     reg = registry()
     if name not in reg:
         raise KeyError(f"unknown effect {name!r}; known: {', '.join(reg)}")
@@ -126,7 +154,18 @@ def get(name: str) -> Effect:
 
 
 def model_changes(effects: dict[str, dict[str, float]] | None) -> ModelChanges:
-    """The FE-model changes of a set of switched-on effects {name: {param: value}}."""
+    """The FE-model changes of a set of switched-on effects.
+
+    Parameters
+    ----------
+    effects : dict or None
+        ``{name: {param: value}}``; every parameter of each effect must be given, within bounds.
+
+    Returns
+    -------
+    ModelChanges
+        The changes of all the effects, applied in turn.
+    """
     ch = ModelChanges()
     for name, params in (effects or {}).items():
         eff = get(name)
@@ -143,7 +182,18 @@ def model_changes(effects: dict[str, dict[str, float]] | None) -> ModelChanges:
 
 
 def parse_assignment(text: str) -> tuple[str, str, float]:
-    """``NAME:PARAM=VALUE`` (command line) -> (effect, parameter, value), checked."""
+    """One effect setting as written on the command line (``--effect``), checked.
+
+    Parameters
+    ----------
+    text : str
+        ``NAME:PARAM=VALUE``, e.g. ``tooth_friction:mu=0.08``.
+
+    Returns
+    -------
+    tuple
+        ``(effect, parameter, value)``.
+    """
     try:
         name, rest = text.split(":", 1)
         pname, value = rest.split("=", 1)

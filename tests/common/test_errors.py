@@ -5,6 +5,7 @@ import shutil
 import pytest
 import yaml
 
+from hdwf.cli import main
 from hdwf.config import load_config
 from hdwf.common.errors import ConfigError, InputError
 from hdwf.study.paper import load_fea_designs
@@ -91,8 +92,6 @@ def test_table_empty_cell(tmp_path):
 def test_plan_command_refuses_bad_input_before_solving(tmp_path, capsys):
     """`hdwf plan`: an existing --out file is kept (no --force), a noise <= 0 is named; both
     are refused before any solve."""
-    from hdwf.cli import main
-
     out = tmp_path / "plan.json"
     out.write_text("keep me")
     rc = main(["plan", "--unit", "hd42", "--designs", "3", "--seed", "1", "--noise-arcmin", "0.05",
@@ -114,8 +113,6 @@ def test_plan_command_refuses_bad_input_before_solving(tmp_path, capsys):
 def test_synth_refuses_a_bad_design_range_before_solving(tmp_path, capsys, text, says):
     """`hdwf synth --range`: a range outside the model's support, reversed, of an unknown
     parameter or badly written is named with the option and its value; no file is written."""
-    from hdwf.cli import main
-
     out = tmp_path / "m.csv"
     rc = main(["synth", "--unit", "hd42", "--designs", "2", "--seed", "1", "--noise-arcmin", "0.01",
                "--range", text, "--out", str(out)])
@@ -126,8 +123,6 @@ def test_synth_refuses_a_bad_design_range_before_solving(tmp_path, capsys, text,
 
 def test_plan_refuses_a_design_range_given_twice(capsys):
     """The same parameter twice in `hdwf plan --range` would silently keep the last one."""
-    from hdwf.cli import main
-
     rc = main(["plan", "--unit", "hd42", "--designs", "2", "--seed", "1", "--noise-arcmin", "0.05",
                "--range", "rFS_mm=0:0.002", "--range", "rFS_mm=0:0.001"])
     err = capsys.readouterr().err

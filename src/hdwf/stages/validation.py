@@ -1,0 +1,258 @@
+"""Stages of the validation campaigns (rules in ``workflow/rules/validation.smk``): a campaign's
+plan from the config, the per-specimen tables, the diagnosis, the ladder and the figures.
+
+Each stage reads its inputs, calls ``hdwf.validation`` and writes what its rule promises.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from hdwf.common.errors import InputError
+from hdwf.common.io import read_json, write_json, write_parquet
+from hdwf.report.figures import ladder_figure, measured_vs_predicted_figure, residual_figure
+from hdwf.validation.diagnosis import Search, diagnose
+from hdwf.validation.jsonsafe import json_safe
+from hdwf.validation.ladder import ladder_variants, solve_ladder
+from hdwf.validation.measurements import load_measurements
+from hdwf.validation.variants import SolveSetup, candidate_names, plan_variants, solve_specimen, specimen_solver
+
+
+@dataclass
+class CampaignPlan:
+    """A validation campaign from ``config.yaml`` (``validation: {NAME: ...}``), resolved."""
+
+    name: str
+    unit: str
+    measurements: str
+    fixed: dict            # effects switched on at given values
+    calibrate_first: list  # effects switched on and calibrated before the search
+    candidates: list       # effects the diagnosis tries
+    rounds: int
+    settings: dict         # mesh settings of its solves
+    steps_per_ramp: int
+
+    def table_variants(self) -> list[dict]:
+        """The variants every specimen's table holds (``hdwf.validation.variants.plan_variants``)."""
+        return plan_variants(self.fixed, self.candidates)
+
+    def search(self) -> Search:
+        """What its diagnosis searches."""
+        return Search(self.fixed, self.calibrate_first, self.candidates, self.rounds)
+
+    def solve_setup(self, jobs: int = 1) -> SolveSetup:
+        """How its specimens are solved, in ``jobs`` processes."""
+        return SolveSetup(self.unit, self.settings, self.steps_per_ramp, jobs)
+
+
+@dataclass(frozen=True)
+class CampaignInputs:
+    """The files a campaign's diagnosis and ladder read."""
+
+    measurements: str | Path   # the measurement file
+    tables: list               # the per-specimen tables (Parquet)
+
+    def read(self):
+        """The checked measurements and the tables, concatenated."""
+        table = pd.concat([pd.read_parquet(p) for p in self.tables], ignore_index=True)
+        return load_measurements(self.measurements), table
+
+
+def campaign_plan(name: str, camp: dict, fe: dict) -> CampaignPlan:
+    """Resolve one campaign of the config.
+
+    Parameters
+    ----------
+    name : str
+        The campaign's name.
+    camp : dict
+        Its config (``validation: {NAME: ...}``), validated by the schema.
+    fe : dict
+        The config's ``fe`` section: the mesh and load steps where the campaign names none.
+
+    Returns
+    -------
+    CampaignPlan
+        ``effects`` split into fixed values and ``calibrate`` ones (which join the candidates),
+        ``candidates: all`` resolved to the registered effects not fixed.
+    """
+    fixed, calib = {}, []
+    for eff, params in camp.get("effects", {}).items():
+        if any(v == "calibrate" for v in params.values()):
+            calib.append(eff)
+        else:
+            fixed[eff] = {p: float(v) for p, v in params.items()}
+    cands = camp.get("candidates", "all")
+    cands = candidate_names(fixed) if cands == "all" else [c for c in cands if c not in fixed]
+    cands = sorted(set(cands) | set(calib))
+    mesh = camp.get("mesh", {})
+    settings = {"elements_over_height": mesh.get("elements_over_height", fe["elements_over_height"]),
+                "elements_over_thickness": mesh.get("elements_over_thickness", fe["elements_over_thickness"]),
+                "refinement": mesh.get("refinement", fe["refinement"]),
+                "symmetry": fe.get("symmetry", "full")}
+    return CampaignPlan(name, camp["unit"], camp["measurements"], fixed, calib, cands,
+                        int(camp.get("rounds", 2)), settings,
+                        int(camp.get("steps_per_ramp", fe["steps_per_ramp"])))
+
+
+def campaign_specimens(plan: CampaignPlan) -> pd.DataFrame:
+    """The campaign's specimens, read and checked from its measurement file.
+
+    Parameters
+    ----------
+    plan : CampaignPlan
+        The campaign.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per specimen (``Measurements.specimens``).
+
+    Raises
+    ------
+    InputError
+        For every problem of the file (with file, row and field), a specimen of another drive
+        or a specimen id that cannot name a file.
+    """
+    spec = load_measurements(plan.measurements).specimens
+    for i, r in spec.iterrows():
+        if r["unit"] != plan.unit:
+            raise InputError(plan.measurements, f"campaign '{plan.name}' is for {plan.unit}",
+                             field="unit", value=r["unit"], row=int(i) + 1)
+        if not re.fullmatch(r"[A-Za-z0-9_.\-]+", str(r["specimen_id"])):
+            raise InputError(plan.measurements, "specimen ids may use letters, digits, '_', '.' and '-' only",
+                             field="specimen_id", value=r["specimen_id"], row=int(i) + 1)
+    return spec
+
+
+def specimen_record(specimens: pd.DataFrame, specimen_id: str) -> dict:
+    """One specimen's id, drive and parameters, as plain values (a rule's ``params``).
+
+    Parameters
+    ----------
+    specimens : pandas.DataFrame
+        The campaign's specimens (``campaign_specimens``).
+    specimen_id : str
+        The specimen.
+
+    Returns
+    -------
+    dict
+        ``specimen_id``, ``unit`` and the ``*_mm`` columns.
+    """
+    row = specimens[specimens["specimen_id"] == specimen_id].iloc[0]
+    return {k: (float(v) if k.endswith("_mm") else str(v)) for k, v in row.items()
+            if k in ("specimen_id", "unit") or k.endswith("_mm")}
+
+
+def specimen_stage(setup: SolveSetup, specimen: dict, variants: list[dict], out, provenance: dict) -> pd.DataFrame:
+    """Mesh one specimen once and solve it for every variant: its campaign table.
+
+    Parameters
+    ----------
+    setup : SolveSetup
+        Drive, mesh settings and load steps.
+    specimen : dict
+        ``specimen_id`` and the parameter columns (``specimen_record``).
+    variants : list of dict
+        The campaign's variants (``CampaignPlan.table_variants``).
+    out : path
+        The table (Parquet).
+    provenance : dict
+        Stamped on the table.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The table written.
+    """
+    table = solve_specimen(setup, specimen, variants)
+    write_parquet(table, out, provenance=provenance,
+                  meta={"unit": setup.unit, "specimen_id": specimen["specimen_id"], "mesh": setup.mesh})
+    return table
+
+
+def diagnosis_stage(plan: CampaignPlan, inputs: CampaignInputs, out_json, out_points, provenance: dict,
+                    jobs: int = 1) -> dict:
+    """Diagnose one campaign from its measurement file and per-specimen tables.
+
+    The solves that anchor an effect found before the next round run here, in ``jobs`` processes.
+
+    Parameters
+    ----------
+    plan : CampaignPlan
+        The campaign.
+    inputs : CampaignInputs
+        Its measurement file and tables.
+    out_json, out_points : path
+        ``diagnosis.json`` and the comparison points (Parquet).
+    provenance : dict
+        Stamped on both.
+    jobs : int
+        Processes of the re-solves.
+
+    Returns
+    -------
+    dict
+        The content of ``diagnosis.json``.
+    """
+    meas, table = inputs.read()
+    solve = specimen_solver(plan.solve_setup(jobs), meas.specimens)
+    diagnosis = diagnose(meas, table, plan.search(), solve=solve)
+    result = json_safe({"campaign": plan.name, "unit": plan.unit, "measurements": str(inputs.measurements),
+                        "mesh": plan.settings, **diagnosis.to_dict(), "provenance": provenance})
+    write_parquet(diagnosis.points, out_points, provenance=provenance, meta={"campaign": plan.name, "unit": plan.unit})
+    write_json(result, out_json)
+    return result
+
+
+def ladder_stage(setup: SolveSetup, inputs: CampaignInputs, diagnosis_json, out, provenance: dict) -> pd.DataFrame:
+    """The ladder of a campaign from actual solves (``hdwf.validation.ladder.solve_ladder``).
+
+    Parameters
+    ----------
+    setup : SolveSetup
+        Drive, mesh settings, load steps and processes of the solves a table lacks.
+    inputs : CampaignInputs
+        Its measurement file and tables.
+    diagnosis_json : path
+        The campaign's ``diagnosis.json``.
+    out : path
+        The ladder (Parquet).
+    provenance : dict
+        Stamped on the ladder.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The ladder written.
+    """
+    meas, table = inputs.read()
+    diag = read_json(diagnosis_json)
+    rungs = ladder_variants(diag["model"]["fixed"], [(f["effect"], f["params"]) for f in diag["found"]])
+    ladder, n_solved = solve_ladder(meas, table, rungs, setup)
+    write_parquet(ladder, out, provenance=provenance,
+                  meta={"campaign": diag["campaign"], "unit": diag["unit"], "solved_for_ladder": n_solved})
+    return ladder
+
+
+def figures_stage(diagnosis_json, points, ladder, out_measured, out_residuals, out_ladder) -> None:
+    """Measured against predicted, the residuals and the ladder of a campaign (PNG).
+
+    Parameters
+    ----------
+    diagnosis_json, points, ladder : path
+        The campaign's ``diagnosis.json``, comparison points and ladder.
+    out_measured, out_residuals, out_ladder : path
+        The three figures.
+    """
+    diag = read_json(diagnosis_json)
+    pts = pd.read_parquet(points)
+    name = f"{diag['campaign']} ({diag['unit'].upper()})"
+    measured_vs_predicted_figure(pts, f"{name}: measured against predicted", out_measured)
+    residual_figure(pts, f"{name}: residuals", out_residuals)
+    ladder_figure(pd.read_parquet(ladder), diag.get("noise_arcmin"), f"{name}: the error ladder", out_ladder)

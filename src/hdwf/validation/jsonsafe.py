@@ -1,0 +1,35 @@
+"""Values as strict JSON takes them: the diagnosis and the detectability plan hold NaN, inf and
+numpy scalars."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def json_safe(obj):
+    """A copy of ``obj`` that ``json.dumps`` writes as strict JSON.
+
+    Parameters
+    ----------
+    obj : object
+        Nested dicts, lists and tuples of numbers, strings, booleans and None.
+
+    Returns
+    -------
+    object
+        The same structure with NaN and inf as None, numpy scalars as Python numbers, tuples
+        as lists and keys as strings.
+    """
+    if isinstance(obj, dict):
+        return {str(k): json_safe(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [json_safe(v) for v in obj]
+    if isinstance(obj, (np.floating, float)):
+        return float(obj) if math.isfinite(obj) else None
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    return obj

@@ -1,0 +1,109 @@
+"""The error ladder: the model's error, rung by rung, as found effects are switched on.
+
+Its rungs are the bare baseline, the campaign's model, then each found effect switched on at
+its calibrated value (cumulative); every rung is judged on actual solves, which checks the
+superposition the diagnosis calibrated with.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+
+from hdwf.validation.comparison import bic
+from hdwf.validation.measurements import Measurements
+from hdwf.validation.observations import observation_frame, predict
+from hdwf.validation.variants import SolveSetup, solve_specimens, variant_key
+
+
+def ladder_variants(fixed: dict, found: list[tuple[str, dict]]) -> list[tuple[str, dict]]:
+    """The model variants of the ladder, in order.
+
+    Parameters
+    ----------
+    fixed : dict
+        The campaign model's effects, ``{effect: {param: value}}``.
+    found : list of tuple
+        ``(effect, params)`` of each effect of the final model, in the order it was switched on.
+
+    Returns
+    -------
+    list of tuple
+        ``(label, effects)``: the bare baseline, the campaign's model (when it has effects),
+        then each found effect switched on at its calibrated value (cumulative).
+    """
+    rungs = [("baseline", {})]
+    if fixed:
+        rungs.append(("campaign model", dict(fixed)))
+    cur = dict(fixed)
+    for effect, params in found:
+        cur = {**cur, effect: params}
+        rungs.append(("with " + ", ".join(e for e in cur if e not in fixed), dict(cur)))
+    return rungs
+
+
+def ladder_table(meas: Measurements, table: pd.DataFrame, rungs: list[tuple[str, dict]]) -> pd.DataFrame:
+    """One row per rung of the ladder, from actual solves.
+
+    Parameters
+    ----------
+    meas : Measurements
+        The checked measurements.
+    table : pandas.DataFrame
+        Tables holding every rung's variant for every specimen.
+    rungs : list of tuple
+        ``(label, effects)`` (``ladder_variants``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``rung``, ``model``, ``effects`` (JSON), ``n_params``, ``rmse_arcmin``, ``bias_arcmin``,
+        ``max_abs_arcmin``, ``delta_bic`` (against the first rung) and ``solved``.
+    """
+    obs = observation_frame(meas)
+    D = obs["D"].to_numpy(float)
+    rows, b0 = [], None
+    for k, (label, eff) in enumerate(rungs):
+        S = predict(table, obs, variant_key(eff))
+        n_par = sum(len(v) for v in eff.values())
+        rss = float(np.nansum((S - D) ** 2))
+        b = bic(rss, len(D), n_par)
+        b0 = b if b0 is None else b0
+        rows.append({"rung": k, "model": label, "effects": json.dumps(eff, sort_keys=True),
+                     "n_params": n_par, "rmse_arcmin": float(np.sqrt(rss / len(D))),
+                     "bias_arcmin": float(np.nanmean(S - D)), "max_abs_arcmin": float(np.nanmax(np.abs(S - D))),
+                     "delta_bic": float(b - b0), "solved": bool(np.isfinite(S).all())})
+    return pd.DataFrame(rows)
+
+
+def solve_ladder(meas: Measurements, table: pd.DataFrame, rungs: list[tuple[str, dict]],
+                 setup: SolveSetup) -> tuple[pd.DataFrame, int]:
+    """The ladder from actual solves: every rung's variant is looked up in the specimens' tables
+    and solved (mesh, wave generator and the missing variants only) where a table lacks it,
+    i.e. for the found effects at their calibrated values.
+
+    Parameters
+    ----------
+    meas : Measurements
+        The checked measurements.
+    table : pandas.DataFrame
+        The campaign's tables.
+    rungs : list of tuple
+        ``(label, effects)`` (``ladder_variants``).
+    setup : SolveSetup
+        Drive, mesh settings, load steps and processes of the solves.
+
+    Returns
+    -------
+    tuple
+        The ladder (``ladder_table``) and the number of variant solves it needed.
+    """
+    have = table.groupby("specimen_id")["variant"].agg(set).to_dict()
+    todo = {sid: [eff for _, eff in rungs if variant_key(eff) not in have.get(sid, set())]
+            for sid in meas.specimens["specimen_id"]}
+    need = meas.specimens[[bool(todo[sid]) for sid in meas.specimens["specimen_id"]]]
+    if len(need):
+        table = pd.concat([table, solve_specimens(setup, need, todo.__getitem__)], ignore_index=True)
+    return ladder_table(meas, table, rungs), int(sum(len(v) for v in todo.values()))

@@ -1,0 +1,269 @@
+"""Model variants and their solves: the FE model with some effects switched on, per specimen.
+
+A *variant* is the baseline FE model with some effects switched on at given values,
+``{effect: {param: value}}``; its key is a canonical string (``"baseline"``,
+``"thermal:delta_T_K=20"``, ``"fs_cup_torsion:K_Nm_per_rad=60000+thermal:delta_T_K=20"``).
+A *table* holds the solved curves of a specimen's variants, one row per load step
+(``TABLE_COLUMNS``).
+
+Reuse between candidates (what makes a campaign affordable):
+
+* one mesh per specimen, built once and shared by every variant of that specimen;
+* one assembly and factorisation of the bodies and one wave-generator stage per specimen:
+  every effect acts only once the teeth engage (``hdwf.fe.solve_lost_motion_variants``),
+  so each variant costs only its torque sequence (and the housing a new CS factorisation);
+* variants that differ only in effects acting in series at the output (``Effect.series``:
+  cup torsion, Oldham play) share one contact solve: their twist is the solved rim twist
+  plus the series element's, exactly;
+* the calibration of every candidate reads the per-specimen tables (each parameter's grid),
+  so it costs no solve at all (``hdwf.validation.calibration``).
+
+Specimens are solved one per process (``solve_specimens``), in fresh interpreters.
+"""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import os
+from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import Callable, Mapping
+
+import numpy as np
+import pandas as pd
+
+from hdwf import PARAMETER_COLUMNS
+from hdwf.drive.design import geometry_of, mesh_design
+from hdwf.drive.geometry import ARCMIN
+from hdwf.fe import ModelChanges, series_output_twist, solve_lost_motion_variants
+from hdwf.validation.effects import get as get_effect
+from hdwf.validation.effects import model_changes, registry
+
+BASELINE = "baseline"
+TABLE_COLUMNS = ["specimen_id", "variant", "step", "torque_Nm", "twist_arcmin", "status"]
+# the thread counts of the BLAS libraries numpy and scipy may be linked against
+_BLAS_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+@dataclass(frozen=True)
+class SolveSetup:
+    """How the specimens of one drive are solved.
+
+    Attributes
+    ----------
+    unit : str
+        The drive (``"hd42"`` or ``"hd120"``).
+    mesh : Mapping
+        Mesh settings (the fields of ``hdwf.drive.design.MeshSettings``).
+    steps_per_ramp : int
+        Load steps per ramp of the test 0 → +T → 0 → −T → 0 (4 × this + 1 points).
+    jobs : int
+        Processes, one specimen each.
+    """
+
+    unit: str
+    mesh: Mapping
+    steps_per_ramp: int = 5
+    jobs: int = 1
+
+
+def variant_key(effects: dict[str, dict[str, float]]) -> str:
+    """The canonical key of a variant.
+
+    Parameters
+    ----------
+    effects : dict
+        ``{effect: {param: value}}``; empty for the baseline.
+
+    Returns
+    -------
+    str
+        ``"baseline"``, or ``effect:param=value`` parts (sorted, ``%.10g``) joined by ``+``.
+    """
+    if not effects:
+        return BASELINE
+    parts = []
+    for name in sorted(effects):
+        for p, v in sorted(effects[name].items()):
+            parts.append(f"{name}:{p}={float(v):.10g}")
+    return "+".join(parts)
+
+
+def candidate_names(fixed: dict | None = None) -> list[str]:
+    """Every registered effect that is not already part of the campaign's model.
+
+    Parameters
+    ----------
+    fixed : dict, optional
+        The effects switched on in the campaign's model, ``{effect: {param: value}}``.
+
+    Returns
+    -------
+    list of str
+        Effect names in registry order.
+    """
+    return [n for n in registry() if n not in (fixed or {})]
+
+
+def plan_variants(fixed: dict[str, dict[str, float]] | None = None,
+                  candidates: list[str] | None = None) -> list[dict]:
+    """The variants of a campaign's tables.
+
+    Parameters
+    ----------
+    fixed : dict, optional
+        The effects switched on in the campaign's model.
+    candidates : list of str, optional
+        The effects to tabulate (default: ``candidate_names(fixed)``); one parameter each.
+
+    Returns
+    -------
+    list of dict
+        The campaign model (baseline + ``fixed``), then for every candidate the model with that
+        effect at each value of its parameter's grid.
+    """
+    fixed = dict(fixed or {})
+    candidates = candidate_names(fixed) if candidates is None else candidates
+    plan = [fixed]
+    for name in candidates:
+        eff = get_effect(name)
+        if len(eff.parameters) != 1:
+            raise ValueError(f"effect {name!r}: calibration handles one-parameter effects only")
+        p = eff.parameters[0]
+        for v in p.grid():
+            plan.append({**fixed, name: {p.name: v}})
+    return plan
+
+
+def _series_shift_arcmin(torque_Nm: np.ndarray, changes: ModelChanges) -> np.ndarray:
+    """What the series elements add to a solved curve (relative to its first point)."""
+    add = series_output_twist(np.zeros(len(torque_Nm)), np.asarray(torque_Nm) * 1000.0,
+                              changes) / ARCMIN
+    return add - add[0]
+
+
+def solve_specimen(setup: SolveSetup, specimen: Mapping, variants: list[dict]) -> pd.DataFrame:
+    """Mesh one specimen and solve it for every variant (one contact solve per distinct FE part).
+
+    Parameters
+    ----------
+    setup : SolveSetup
+        Drive, mesh settings and load steps (``jobs`` is not used).
+    specimen : Mapping
+        ``specimen_id`` and the parameter columns ``d_mm`` … ``rCS_mm``.
+    variants : list of dict
+        The variants, ``{effect: {param: value}}`` each.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The specimen's table (``TABLE_COLUMNS``), variants in the given order. A variant whose
+        solve fails gets ``status = "failed: <reason>"`` and NaN twists.
+    """
+    params = {c: float(specimen[c]) for c in PARAMETER_COLUMNS}
+    mesh = mesh_design(setup.unit, params, setup.mesh)
+    steps = setup.steps_per_ramp
+    changes = [model_changes(eff) for eff in variants]
+    parts = list(dict.fromkeys(ch.fe_part() for ch in changes))   # distinct, in order
+    solved = dict(zip(parts, solve_lost_motion_variants(geometry_of(setup.unit, params), mesh, steps, parts)))
+    frames = []
+    for eff, ch in zip(variants, changes):
+        res = solved[ch.fe_part()]
+        ok = res.status == "ok"
+        if ok:
+            tw = res.twist_arcmin + _series_shift_arcmin(res.torque_Nm, ch)
+            step, torque = res.step, res.torque_Nm
+        else:
+            step = np.arange(4 * steps + 1)
+            torque = np.full(step.size, np.nan)
+            tw = np.full(step.size, np.nan)
+        frames.append(pd.DataFrame({
+            "specimen_id": specimen["specimen_id"], "variant": variant_key(eff),
+            "step": np.asarray(step, dtype="int64"), "torque_Nm": np.asarray(torque, float),
+            "twist_arcmin": np.asarray(tw, float),
+            "status": "ok" if ok else f"failed: {res.reason}"}))
+    return pd.concat(frames, ignore_index=True)[TABLE_COLUMNS]
+
+
+def _specimen_job(task: tuple[SolveSetup, dict, list[dict]]) -> pd.DataFrame:
+    return solve_specimen(*task)
+
+
+@contextmanager
+def _one_blas_thread():
+    """BLAS limited to one thread in the processes started inside the block."""
+    saved = {k: os.environ.get(k) for k in _BLAS_VARS}
+    os.environ.update({k: "1" for k in _BLAS_VARS})
+    try:
+        yield
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+def solve_specimens(setup: SolveSetup, specimens: pd.DataFrame,
+                    variants_of: Callable[[str], list[dict]]) -> pd.DataFrame:
+    """``solve_specimen`` for every specimen row, in ``setup.jobs`` processes.
+
+    Parameters
+    ----------
+    setup : SolveSetup
+        Drive, mesh settings, load steps and processes.
+    specimens : pandas.DataFrame
+        One row per specimen: ``specimen_id`` and the parameter columns.
+    variants_of : callable
+        ``variants_of(specimen_id)`` gives that specimen's list of variants.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The specimens' tables, concatenated in specimen order.
+    """
+    tasks = [(setup, {"specimen_id": r["specimen_id"], **{c: float(r[c]) for c in PARAMETER_COLUMNS}},
+              variants_of(r["specimen_id"])) for _, r in specimens.iterrows()]
+    if setup.jobs <= 1 or len(tasks) <= 1:
+        out = [_specimen_job(t) for t in tasks]
+    else:
+        # fresh interpreters with one BLAS thread each: the dense solves are small, and
+        # 2 processes x 2 BLAS threads on 2 cores only fight
+        with _one_blas_thread(), ProcessPoolExecutor(max_workers=setup.jobs,
+                                                     mp_context=mp.get_context("spawn")) as ex:
+            out = list(ex.map(_specimen_job, tasks))
+    return pd.concat(out, ignore_index=True)
+
+
+def specimen_solver(setup: SolveSetup, specimens: pd.DataFrame) -> Callable[[list[dict]], pd.DataFrame]:
+    """The same variants solved for every specimen (``setup`` and ``specimens`` as for
+    ``solve_specimens``).
+
+    Returns
+    -------
+    callable
+        ``solve(variants)``: the tables of every specimen for those variants (``solve_specimens``).
+    """
+    def solve(variants: list[dict]) -> pd.DataFrame:
+        return solve_specimens(setup, specimens, lambda _: variants)
+    return solve
+
+
+def mean_lost_motion(table: pd.DataFrame, fixed: dict | None = None) -> float:
+    """The signal that noise levels are quoted against.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        Solved tables of one or more specimens (``TABLE_COLUMNS``).
+    fixed : dict, optional
+        The campaign model's effects (default: the baseline).
+
+    Returns
+    -------
+    float
+        Mean over specimens of the twist range of the campaign model's curves (arcmin).
+    """
+    base = table[table["variant"] == variant_key(fixed or {})]
+    return float(base.groupby("specimen_id")["twist_arcmin"].agg(lambda t: t.max() - t.min()).mean())
