@@ -1,10 +1,12 @@
-"""hdwf: a reproducible study of harmonic-drive lost motion.
+"""hdwf: a reproducible study of harmonic-drive lost motion, and its model against measurements.
 
-One module per stage: ``doe`` (designs of experiments), ``paper`` (the seed paper's tables),
-``aggregate`` (per-design results into one Parquet table), ``stats`` (regression and
-correlation), ``surrogate`` (the quadratic of the paper's Eq. 11), ``sobol`` (sensitivity
-indices, estimated and exact), ``plots`` and ``report``; ``config``, ``provenance`` and
-``io`` are shared plumbing.  The library knows nothing of Snakemake.
+Subpackages by concept (``docs/architecture.md``): ``common`` (atomic I/O, provenance,
+errors), ``drive`` (geometry and gmsh mesh of a design), ``fe`` (the FE model and its contact
+solver), ``study`` (designs of experiments, the paper's tables, statistics, surrogate, Sobol'
+indices, mesh convergence), ``validation`` (measurements, candidate effects, calibration,
+diagnosis, ladder), ``report`` (the typst PDF and its figures) and ``stages`` (read -> compute
+-> write, one module per rule file); ``config`` and ``cli`` on top.  The library knows
+nothing of Snakemake.
 """
 
 __version__ = "0.1.0"
