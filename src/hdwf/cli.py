@@ -9,8 +9,8 @@ from pathlib import Path
 
 from hdwf.common.errors import InputError
 from hdwf.common.io import atomic_path
-from hdwf.common.provenance import provenance
-from hdwf.config import config_hash, load_config
+from hdwf.common.provenance import config_hash, provenance
+from hdwf.config import load_config
 from hdwf.study.paper import paper_measurements
 from hdwf.validation.detectability import plan_detectability
 from hdwf.validation.effects import parse_assignment, registry

@@ -13,7 +13,6 @@ import jsonschema
 import yaml
 
 from hdwf.common.errors import ConfigError
-from hdwf.common.provenance import config_hash  # noqa: F401  (re-exported: `hdwf check-config` prints it)
 from hdwf.validation.effects import registry
 
 
