@@ -5,18 +5,16 @@
 # Rules live in workflow/rules/*.smk; scripts in workflow/scripts/ are thin adapters over the
 # installed `hdwf` package (pip install -e .).
 
-from pathlib import Path
-
 from snakemake.utils import min_version
 
-from hdwf.config import validate_config
+from hdwf.config import SCHEMA_PATH, validate_config
 
 min_version("9.0")
 
 configfile: "config.yaml"
 
 # Fail at start-up, naming the key, before any job runs.
-validate_config(config, Path(workflow.basedir) / "workflow/schemas/config.schema.yaml",
+validate_config(config, SCHEMA_PATH,
                 source=(workflow.overwrite_configfiles or ["config.yaml"])[-1])
 
 include: "workflow/rules/common.smk"

@@ -4,13 +4,15 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from pathlib import Path
 
+from hdwf import __version__
 from hdwf.common.errors import InputError
 from hdwf.common.io import atomic_path
 from hdwf.common.provenance import config_hash, provenance
-from hdwf.config import load_config
+from hdwf.config import SCHEMA_PATH, load_config
 from hdwf.study.paper import paper_measurements
 from hdwf.validation.detectability import plan_detectability
 from hdwf.validation.effects import parse_assignment, registry
@@ -158,12 +160,13 @@ def _paper_measurements(args) -> int:
 def main(argv=None) -> int:
     """Run the ``hdwf`` command ``argv`` (default: the process's arguments); its exit status."""
     parser = argparse.ArgumentParser(prog="hdwf", description="Harmonic-drive lost-motion study tools.")
+    parser.add_argument("--version", action="version", version=f"hdwf {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     for name, func, help_ in (("check-config", _check_config, "validate a config file against the schema"),
                               ("provenance", _provenance, "print config hash, git commit and package versions")):
         p = sub.add_parser(name, help=help_)
         p.add_argument("config", nargs="?", default="config.yaml")
-        p.add_argument("--schema", default="workflow/schemas/config.schema.yaml")
+        p.add_argument("--schema", default=str(SCHEMA_PATH))
         p.set_defaults(func=func)
     p = sub.add_parser("paper-measurements", help="the paper's Tables 4/5 as a measurement file")
     p.add_argument("--unit", required=True, choices=["hd42", "hd120"])
@@ -200,6 +203,10 @@ def main(argv=None) -> int:
     except InputError as exc:
         print(f"hdwf: error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:
+        # the reader went away (e.g. `hdwf effects | head`): stop quietly, as a Unix tool does
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
 
 
 if __name__ == "__main__":

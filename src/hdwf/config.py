@@ -15,12 +15,15 @@ import yaml
 from hdwf.common.errors import ConfigError
 from hdwf.validation.effects import registry
 
+#: The schema of config.yaml, shipped inside the package so the CLI works from any folder.
+SCHEMA_PATH = Path(__file__).with_name("config.schema.yaml")
+
 
 def _key_path(error: jsonschema.ValidationError) -> str:
     return ".".join(str(p) for p in error.absolute_path) or "(top level)"
 
 
-def validate_config(config: dict, schema_path: str | Path, source: str | Path = "config.yaml") -> dict:
+def validate_config(config: dict, schema_path: str | Path = SCHEMA_PATH, source: str | Path = "config.yaml") -> dict:
     """Validate ``config`` in place, filling schema defaults; raise ConfigError on the first problem.
 
     Every problem found is listed in the message, worst (shallowest) first.
@@ -110,10 +113,14 @@ def _check_campaign(name: str, camp: dict, source) -> None:
                                   value=c)
 
 
-def load_config(path: str | Path, schema_path: str | Path) -> dict:
+def load_config(path: str | Path, schema_path: str | Path = SCHEMA_PATH) -> dict:
+    """Read a config file and validate it; a missing, unreadable or malformed file is a ConfigError."""
     path = Path(path)
     try:
         config = yaml.safe_load(path.read_text()) or {}
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else "not a text file"
+        raise ConfigError(path, f"cannot read the config: {reason}") from exc
     except yaml.YAMLError as exc:
         raise ConfigError(path, f"not valid YAML: {exc}") from exc
     return validate_config(config, schema_path, path)

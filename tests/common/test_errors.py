@@ -12,7 +12,7 @@ from hdwf.study.paper import load_fea_designs
 
 from conftest import ROOT
 
-SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
+SCHEMA = ROOT / "src" / "hdwf" / "config.schema.yaml"
 
 
 def _config_with(tmp_path, edit):

@@ -11,7 +11,7 @@ from hdwf.study.paper import load_fea_designs, paper_measurements
 
 from conftest import DATA, ROOT
 
-SCHEMA = ROOT / "workflow/schemas/config.schema.yaml"
+SCHEMA = ROOT / "src/hdwf/config.schema.yaml"
 
 
 @pytest.mark.parametrize("unit", ["hd42", "hd120"])

@@ -1,0 +1,64 @@
+"""The `hdwf` command from any folder: packaged schema, one-line errors, --version, closed pipes."""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from hdwf import __version__
+from hdwf.cli import main
+
+from conftest import ROOT
+
+HDWF = str(Path(sys.executable).with_name("hdwf"))
+
+
+def _run(args, cwd):
+    return subprocess.run([HDWF, *args], cwd=cwd, capture_output=True, text=True, timeout=120)
+
+
+def test_check_config_works_outside_the_project(tmp_path):
+    run = _run(["check-config", str(ROOT / "config.yaml")], cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    assert "valid; config hash" in run.stdout
+
+
+@pytest.mark.parametrize("make, says", [
+    (lambda d: d / "missing.yaml", "No such file or directory"),
+    (lambda d: d, "Is a directory"),
+    (lambda d: (d / "binary.yaml").write_bytes(b"\xff\xfe\x00\x81") and d / "binary.yaml", "not a text file"),
+])
+def test_an_unreadable_config_is_one_line_and_exit_2(tmp_path, capsys, make, says):
+    path = make(tmp_path)
+    assert main(["check-config", str(path)]) == 2
+    assert capsys.readouterr().err.strip().splitlines() == [f"hdwf: error: {path}: cannot read the config: {says}"]
+
+
+def test_version(capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(["--version"])
+    assert stop.value.code == 0
+    assert capsys.readouterr().out.strip() == f"hdwf {__version__}"
+
+
+def test_a_closed_pipe_ends_quietly(monkeypatch):
+    read_end, write_end = os.pipe()
+
+    class ClosedPipe:
+        def write(self, text):
+            raise BrokenPipeError
+
+        def flush(self):
+            pass
+
+        def fileno(self):
+            return write_end
+
+    monkeypatch.setattr(sys, "stdout", ClosedPipe())
+    try:
+        assert main(["effects"]) == 1
+    finally:
+        os.close(read_end)
+        os.close(write_end)
