@@ -2,7 +2,6 @@
 
 from hdwf.study.paper import FEA_TABLES
 
-REPO_DIR = workflow.basedir
 STUDIES = config["studies"]
 PAPER_STUDIES = [s for s, v in STUDIES.items() if v["source"] == "paper"]
 FE_STUDIES = [s for s, v in STUDIES.items() if v["source"] == "fe"]
