@@ -5,19 +5,33 @@
 # Rules live in workflow/rules/*.smk; scripts in workflow/scripts/ are thin adapters over the
 # installed `hdwf` package (pip install -e .).
 
+from pathlib import Path
+
 from snakemake.utils import min_version
 
 from hdwf.config import SCHEMA_PATH, validate_config
 
 min_version("9.0")
 
+report: "workflow/report/workflow.rst"
+
 configfile: "config.yaml"
 
 # Fail at start-up, naming the key, before any job runs.
+# With --configfile, a problem is blamed on the last file that sets the key.
 validate_config(config, SCHEMA_PATH,
-                source=(workflow.overwrite_configfiles or ["config.yaml"])[-1])
+                source=[*(["config.yaml"] if Path("config.yaml").exists() else []), *workflow.overwrite_configfiles])
 
 include: "workflow/rules/common.smk"
+
+wildcard_constraints:
+    unit="hd42|hd120",
+    study=_alternatives(list(STUDIES)),
+    design=r"[A-Za-z0-9_\-]+",
+    ref=r"[0-9.]+",
+    campaign=_alternatives(list(CAMPAIGNS)),
+    specimen=r"[A-Za-z0-9_.\-]+",
+
 include: "workflow/rules/doe.smk"
 include: "workflow/rules/paper.smk"
 include: "workflow/rules/fe.smk"
@@ -39,17 +53,6 @@ rule all:
 rule paper:
     input:
         "results/paper/report.pdf",
-
-
-def fe_study_targets():
-    out = []
-    for study in FE_STUDIES:
-        for unit in study_units(study):
-            out += [f"results/{study}/{unit}/{name}" for name in
-                    ("lost_motion.parquet", "curves.parquet", "correlation.parquet", "surrogate.json", "sobol.parquet")]
-    conv = FE["convergence"]["study"]
-    out += [f"results/{conv}/{unit}/convergence.parquet" for unit in study_units(conv)]
-    return out
 
 
 rule fe_studies:

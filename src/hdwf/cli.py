@@ -44,7 +44,7 @@ def _solve_setup(args) -> SolveSetup:
     mesh = {"elements_over_height": args.elements_over_height,
             "elements_over_thickness": args.elements_over_thickness,
             "refinement": args.refinement, "symmetry": "half"}
-    return SolveSetup(args.unit, mesh, args.steps_per_ramp, args.jobs)
+    return SolveSetup(args.unit, mesh, args.steps_per_ramp, args.jobs, progress=True)
 
 
 def _specimen_options(p, seed_help: str, noise_help: str) -> None:

@@ -23,11 +23,59 @@ def _key_path(error: jsonschema.ValidationError) -> str:
     return ".".join(str(p) for p in error.absolute_path) or "(top level)"
 
 
-def validate_config(config: dict, schema_path: str | Path = SCHEMA_PATH, source: str | Path = "config.yaml") -> dict:
+def validate_config(config: dict, schema_path: str | Path = SCHEMA_PATH,
+                    source: str | Path | list[str | Path] = "config.yaml") -> dict:
     """Validate ``config`` in place, filling schema defaults; raise ConfigError on the first problem.
 
     Every problem found is listed in the message, worst (shallowest) first.
+
+    Parameters
+    ----------
+    config
+        The merged configuration.
+    schema_path
+        The JSON schema (YAML).
+    source
+        The file the config was read from, or the files in the order they were merged (later
+        ones override, as Snakemake's ``configfile:`` then ``--configfile``): a problem is then
+        blamed on the last file that sets the offending key, or on ``--config`` if none does.
     """
+    sources = [source] if isinstance(source, (str, Path)) else list(source)
+    try:
+        _check_schema(config, schema_path, sources[-1])
+        _check_relations(config, sources[-1])
+    except ConfigError as exc:
+        if len(sources) < 2 or exc.field is None:
+            raise
+        raise ConfigError(blame(sources, exc.field, exc.value), exc.problem, row=exc.row, field=exc.field,
+                          value=exc.value) from None
+    return config
+
+
+def blame(sources: list[str | Path], field: str, value=None) -> str:
+    """The last of ``sources`` (merged in order) whose YAML sets the dotted key ``field``.
+
+    If that file sets it to another value than the offending ``value``, ``--config`` on the
+    command line overrode it.
+    """
+    for path in reversed(sources):
+        try:
+            node = yaml.safe_load(Path(path).read_text())
+        except (OSError, UnicodeDecodeError, yaml.YAMLError):
+            continue
+        for key in field.split("."):
+            if isinstance(node, dict) and key in node:
+                node = node[key]
+            elif isinstance(node, list) and key.isdigit() and int(key) < len(node):
+                node = node[int(key)]
+            else:
+                break
+        else:
+            return str(path) if value is None or node == value else "--config (command line)"
+    return "--config (command line)"
+
+
+def _check_schema(config: dict, schema_path: str | Path, source) -> None:
     schema = yaml.safe_load(Path(schema_path).read_text())
     validator_cls = jsonschema.validators.validator_for(schema)
     # Fill defaults so downstream code never meets a missing optional key.
@@ -46,8 +94,6 @@ def validate_config(config: dict, schema_path: str | Path = SCHEMA_PATH, source:
             f"{_key_path(e)}: {e.message}" for e in errors[1:4]) + ")"
         value = first.instance if not isinstance(first.instance, (dict, list)) else None
         raise ConfigError(source, f"{first.message}{others}", field=_key_path(first), value=value)
-    _check_relations(config, source)
-    return config
 
 
 def _check_relations(config: dict, source) -> None:

@@ -5,6 +5,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pandas as pd
 import pytest
 
 from hdwf import __version__
@@ -62,3 +63,17 @@ def test_a_closed_pipe_ends_quietly(monkeypatch):
     finally:
         os.close(read_end)
         os.close(write_end)
+
+
+@pytest.mark.slow
+def test_synth_shows_progress_and_writes_the_test_cycle(tmp_path, capsys):
+    out = tmp_path / "bench.csv"
+    rc = main(["synth", "--unit", "hd42", "--designs", "2", "--seed", "1", "--noise-arcmin", "0",
+               "--elements-over-height", "4", "--elements-over-thickness", "2", "--refinement", "0.5",
+               "--steps-per-ramp", "2", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert rc == 0, err
+    assert "hd42: 2 solves" in err and "2/2" in err  # the bar reached the last specimen
+    data = pd.read_csv(out)
+    # 0 -> +T -> 0 -> -T -> 0 at 2 steps per ramp: 4 x 2 + 1 points per specimen
+    assert data.groupby("specimen_id").size().tolist() == [9, 9]

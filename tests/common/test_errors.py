@@ -6,7 +6,7 @@ import pytest
 import yaml
 
 from hdwf.cli import main
-from hdwf.config import load_config
+from hdwf.config import load_config, validate_config
 from hdwf.common.errors import ConfigError, InputError
 from hdwf.study.paper import load_fea_designs
 
@@ -31,6 +31,7 @@ def test_shipped_config_is_valid():
 @pytest.mark.parametrize("edit, field, value", [
     (lambda c: c["doe"].update(n_designs="many"), "doe.n_designs", "many"),            # wrong type
     (lambda c: c["doe"].update(n_designs=5), "doe.n_designs", 5),                      # below 22
+    (lambda c: c["doe"].update(n_designs=100_000), "doe.n_designs", 100_000),          # a DAG no laptop holds
     (lambda c: c["sobol"].update(tolerance=-0.1), "sobol.tolerance", -0.1),            # out of range
     (lambda c: c["sobol"].update(samplers=["monte-carlo"]), "sobol.samplers.0", "monte-carlo"),
     (lambda c: c["studies"]["paper"].update(units=["hd50"]), "studies.paper.units.0", "hd50"),
@@ -48,6 +49,24 @@ def test_unknown_key_is_refused(tmp_path):
     path = _config_with(tmp_path, lambda c: c["sobol"].update(tolerence=0.01))
     with pytest.raises(ConfigError, match="tolerence"):
         load_config(path, SCHEMA)
+
+
+def test_a_problem_is_blamed_on_the_config_file_that_sets_the_key(tmp_path):
+    """Snakemake merges config.yaml, then each --configfile: the error names the file to fix."""
+    first = tmp_path / "first.yaml"
+    first.write_text("doe:\n  n_designs: 5\n")
+    second = tmp_path / "second.yaml"
+    second.write_text("sobol:\n  n_start: 64\n")
+    config = yaml.safe_load((ROOT / "config.yaml").read_text())
+    config["doe"]["n_designs"] = 5
+    with pytest.raises(ConfigError) as exc:
+        validate_config(config, SCHEMA, [ROOT / "config.yaml", first, second])
+    assert exc.value.file == str(first) and exc.value.field == "doe.n_designs"
+    config = yaml.safe_load((ROOT / "config.yaml").read_text())
+    config["sobol"]["n_start"] = 100  # set by none of the files: it came from --config
+    with pytest.raises(ConfigError) as exc:
+        validate_config(config, SCHEMA, [ROOT / "config.yaml", first, second])
+    assert exc.value.file == "--config (command line)"
 
 
 def _copy_tables(tmp_path):

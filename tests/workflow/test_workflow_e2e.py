@@ -1,8 +1,13 @@
 """End to end: `snakemake --cores 2 paper` in a fresh copy of the workflow."""
 
+import os
+import re
 import shutil
+import signal
 import subprocess
 import sys
+import time
+import zipfile
 from pathlib import Path
 
 import pandas as pd
@@ -22,11 +27,18 @@ def _workspace(tmp_path):
     return tmp_path
 
 
-@pytest.mark.e2e
-def test_paper_target(tmp_path):
-    ws = _workspace(tmp_path)
+@pytest.fixture(scope="module")
+def paper_run(tmp_path_factory):
+    """A clean `snakemake --cores 2 paper` in a fresh copy, shared by the tests that compare with it."""
+    ws = _workspace(tmp_path_factory.mktemp("paper_run"))
     run = subprocess.run([SNAKEMAKE, "--cores", "2", "paper"], cwd=ws, capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, run.stderr[-3000:]
+    return ws
+
+
+@pytest.mark.e2e
+def test_paper_target(paper_run):
+    ws = paper_run
     pdf = ws / "results/paper/report.pdf"
     assert pdf.read_bytes()[:5] == b"%PDF-" and pdf.stat().st_size > 100_000
     for unit, rho in (("hd42", 0.6758), ("hd120", 0.7027)):
@@ -41,6 +53,55 @@ def test_paper_target(tmp_path):
     again = subprocess.run([SNAKEMAKE, "--cores", "2", "paper", "--dry-run"], cwd=ws, capture_output=True,
                            text=True, timeout=120)
     assert "Nothing to be done" in again.stdout + again.stderr  # a rerun rebuilds nothing
+    _check_snakemake_report(ws)
+
+
+def _check_snakemake_report(ws):
+    """`snakemake --report` of the finished target: every figure tagged report() is in the zip,
+    filed under its study and drive, with its caption filled in."""
+    run = subprocess.run([SNAKEMAKE, "--report", "report.zip", "paper"], cwd=ws, capture_output=True, text=True,
+                         timeout=300)
+    assert run.returncode == 0, run.stderr[-3000:]
+    with zipfile.ZipFile(ws / "report.zip") as z:
+        names = z.namelist()
+        html = z.read("report/report.html").decode()
+    figures = sorted(Path(n).name for n in names if n.endswith((".png", ".pdf")))
+    assert figures == sorted(["report.pdf"] + 2 * ["correlation.png", "surrogate.png", "sobol_convergence.png"])
+    categories = re.search(r"var categories = (\{.*?\});", html).group(1)
+    assert '"paper": {"hd42": [' in categories and '"hd120": [' in categories
+    assert "drive hd120: lost motion" in html  # caption with the job's wildcards
+
+
+@pytest.mark.e2e
+def test_kill_9_then_the_readme_resume_gives_the_clean_run(tmp_path, paper_run):
+    """`kill -9` of Snakemake while a job runs: no half-written artefact, the rerun stops at the
+    lock, and the README's resume command completes with results equal to a clean run."""
+    ws = _workspace(tmp_path)
+    targets = [f"results/paper/{unit}/sobol.parquet" for unit in ("hd42", "hd120")]
+    running = subprocess.Popen([SNAKEMAKE, "--cores", "2", *targets], cwd=ws, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL, start_new_session=True)
+    started = ws / "results/logs/paper_hd42_sobol.log"   # Snakemake makes the log as the job starts
+    deadline = time.monotonic() + 300
+    while not started.exists() and running.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    os.killpg(running.pid, signal.SIGKILL)
+    running.wait()
+    assert started.exists() and not (ws / targets[0]).exists()   # killed inside the job, nothing half-written
+    locked = subprocess.run([SNAKEMAKE, "--cores", "2", *targets], cwd=ws, capture_output=True, text=True,
+                            timeout=120)
+    assert locked.returncode != 0 and "--unlock" in locked.stdout + locked.stderr
+    readme = (ROOT / "README.md").read_text()
+    assert ".venv/bin/snakemake --unlock && .venv/bin/snakemake --cores 2 --rerun-incomplete" in readme
+    for args in (["--unlock"], ["--cores", "2", "--rerun-incomplete", *targets]):
+        run = subprocess.run([SNAKEMAKE, *args], cwd=ws, capture_output=True, text=True, timeout=600)
+        assert run.returncode == 0, run.stderr[-3000:]
+    for unit in ("hd42", "hd120"):
+        for name in ("lost_motion.parquet", "sobol.parquet"):
+            pd.testing.assert_frame_equal(pd.read_parquet(ws / f"results/paper/{unit}/{name}"),
+                                          pd.read_parquet(paper_run / f"results/paper/{unit}/{name}"),
+                                          check_exact=True)
+        assert read_json(ws / f"results/paper/{unit}/surrogate.json") == \
+            read_json(paper_run / f"results/paper/{unit}/surrogate.json")
 
 
 @pytest.mark.e2e

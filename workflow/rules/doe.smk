@@ -2,7 +2,7 @@
 
 rule doe:
     input:
-        bounds=f"{config['paper_data']}/table3_bounds.csv",
+        bounds=paper_file("table3_bounds.csv"),
     output:
         "results/doe/{unit}/designs.parquet",
     params:

@@ -1,22 +1,15 @@
 # Our FE model: per-design mesh -> solve (one core each, 2 jobs at once on 2 cores), then
 # aggregation into the study's lost_motion.parquet and curves.parquet, and mesh convergence.
 
-def _fe_design_source(w):
-    if STUDIES[w.study]["designs"] == "paper":
-        return f"{config['paper_data']}/{FEA_TABLES[w.unit]}"
-    return f"results/doe/{w.unit}/designs.parquet"
-
-
 rule fe_designs:
     input:
-        _fe_design_source,
+        fe_design_source,
     output:
         "results/{study}/{unit}/designs.parquet",
     wildcard_constraints:
         study=_alternatives(FE_STUDIES),
     params:
         designs=lambda w: STUDIES[w.study]["designs"],
-        data_dir=config["paper_data"],
     log:
         "results/logs/{study}_{unit}_designs.log",
     script:
@@ -70,7 +63,6 @@ rule fe_aggregate:
         curves="results/{study}/{unit}/curves.parquet",
     wildcard_constraints:
         study=_alternatives(FE_STUDIES),
-    params:
     log:
         "results/logs/{study}_{unit}_aggregate.log",
     script:
@@ -97,21 +89,9 @@ rule fe_refined_solve:
         "../scripts/fe_refined_solve.py"
 
 
-def _convergence_inputs(w):
-    """Every design also on the other of the two finest meshes; every k-th also on the third (GCI)."""
-    finest, second, coarsest = sorted(FE["convergence"]["refinements"], reverse=True)
-    pair_partner = finest if FE["refinement"] == second else second
-    designs = design_ids(w.study, w.unit)
-    every = FE["convergence"]["representative_every"]
-    files = {"default": f"results/{w.study}/{w.unit}/lost_motion.parquet"}
-    files["other_meshes"] = [f"results/{w.study}/{w.unit}/convergence/r{pair_partner:g}/{d}.parquet" for d in designs]
-    files["other_meshes"] += [f"results/{w.study}/{w.unit}/convergence/r{coarsest:g}/{d}.parquet" for d in designs[::every]]
-    return files
-
-
 rule fe_convergence:
     input:
-        unpack(_convergence_inputs),
+        unpack(convergence_inputs),
     output:
         "results/{study}/{unit}/convergence.parquet",
     wildcard_constraints:
@@ -129,7 +109,8 @@ rule fe_deformed:
     input:
         "results/{study}/{unit}/designs.parquet",
     output:
-        png="results/{study}/{unit}/deformed_{design}.png",
+        png=report("results/{study}/{unit}/deformed_{design}.png", caption="../report/deformed.rst",
+                   category="{study}", subcategory="{unit}"),
         fields="results/{study}/{unit}/deformed_{design}.npz",
     params:
         settings={k: FE[k] for k in ("elements_over_height", "elements_over_thickness", "refinement", "symmetry")},

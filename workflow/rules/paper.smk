@@ -2,13 +2,11 @@
 
 rule paper_lost_motion:
     input:
-        table=lambda w: f"{config['paper_data']}/{FEA_TABLES[w.unit]}",
+        table=lambda w: paper_file(FEA_TABLES[w.unit]),
     output:
         "results/{study}/{unit}/lost_motion.parquet",
     wildcard_constraints:
         study=_alternatives(PAPER_STUDIES),
-    params:
-        data_dir=config["paper_data"],
     log:
         "results/logs/{study}_{unit}_lost_motion.log",
     script:

@@ -5,8 +5,8 @@ rule correlation:
         "results/{study}/{unit}/lost_motion.parquet",
     output:
         table="results/{study}/{unit}/correlation.parquet",
-        figure="results/{study}/{unit}/correlation.png",
-    params:
+        figure=report("results/{study}/{unit}/correlation.png", caption="../report/correlation.rst",
+                      category="{study}", subcategory="{unit}"),
     log:
         "results/logs/{study}_{unit}_correlation.log",
     script:
@@ -16,13 +16,13 @@ rule correlation:
 rule surrogate:
     input:
         lost_motion="results/{study}/{unit}/lost_motion.parquet",
-        bounds=f"{config['paper_data']}/table3_bounds.csv",
+        bounds=paper_file("table3_bounds.csv"),
     output:
         model="results/{study}/{unit}/surrogate.json",
-        figure="results/{study}/{unit}/surrogate.png",
+        figure=report("results/{study}/{unit}/surrogate.png", caption="../report/surrogate.rst",
+                      category="{study}", subcategory="{unit}"),
     params:
         bounds_source=lambda w: STUDIES[w.study]["surrogate_bounds"],
-        data_dir=config["paper_data"],
     log:
         "results/logs/{study}_{unit}_surrogate.log",
     script:
@@ -31,14 +31,15 @@ rule surrogate:
 
 rule sobol:
     input:
-        "results/{study}/{unit}/surrogate.json",
+        surrogate="results/{study}/{unit}/surrogate.json",
+        bounds=paper_file("table3_bounds.csv"),
     output:
         table="results/{study}/{unit}/sobol.parquet",
-        figure="results/{study}/{unit}/sobol_convergence.png",
+        figure=report("results/{study}/{unit}/sobol_convergence.png", caption="../report/sobol.rst",
+                      category="{study}", subcategory="{unit}"),
     params:
         settings={k: v for k, v in config["sobol"].items() if k != "samplers"},
         samplers=config["sobol"]["samplers"],
-        data_dir=config["paper_data"],
     log:
         "results/logs/{study}_{unit}_sobol.log",
     script:

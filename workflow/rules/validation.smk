@@ -3,38 +3,6 @@
 # specimen, in parallel); the diagnosis calibrates and ranks the candidates; the ladder re-solves
 # the model with the found effects switched on; figures for the report.
 
-import dataclasses
-
-from hdwf.stages.validation import campaign_plan, campaign_specimens, specimen_record
-
-CAMPAIGNS = {name: campaign_plan(name, c, FE) for name, c in config.get("validation", {}).items()}
-_SPECIMENS = {}
-
-
-def specimens_of(campaign):
-    """The campaign's specimens, read (and checked) once from its measurement file."""
-    if campaign not in _SPECIMENS:
-        _SPECIMENS[campaign] = campaign_specimens(CAMPAIGNS[campaign])
-    return _SPECIMENS[campaign]
-
-
-def specimen_ids(campaign):
-    return list(specimens_of(campaign)["specimen_id"])
-
-
-def specimen_row(w):
-    return specimen_record(specimens_of(w.campaign), w.specimen)
-
-
-def plan_dict(w):
-    return dataclasses.asdict(CAMPAIGNS[w.campaign])
-
-
-wildcard_constraints:
-    campaign=_alternatives(list(CAMPAIGNS)),
-    specimen=r"[A-Za-z0-9_.\-]+",
-
-
 rule validation_specimen:
     output:
         "results/validation/{campaign}/tables/{specimen}.parquet",
@@ -111,9 +79,12 @@ rule validation_figures:
         points="results/validation/{campaign}/points.parquet",
         ladder="results/validation/{campaign}/ladder.parquet",
     output:
-        measured="results/validation/{campaign}/measured_vs_predicted.png",
-        residuals="results/validation/{campaign}/residuals.png",
-        ladder="results/validation/{campaign}/ladder.png",
+        measured=report("results/validation/{campaign}/measured_vs_predicted.png", caption="../report/validation.rst",
+                        category="validation", subcategory="{campaign}"),
+        residuals=report("results/validation/{campaign}/residuals.png", caption="../report/validation.rst",
+                         category="validation", subcategory="{campaign}"),
+        ladder=report("results/validation/{campaign}/ladder.png", caption="../report/validation.rst",
+                      category="validation", subcategory="{campaign}"),
     log:
         "results/logs/validation_{campaign}_figures.log",
     script:

@@ -21,6 +21,16 @@ def setup(snakemake):
     return provenance(snakemake.config, PROJECT_ROOT)
 
 
+def folder_of(paths) -> Path:
+    """The one folder that holds the given input file(s): a rule declares the files it reads (so
+    an edit re-runs it) and the library is given their folder."""
+    paths = [paths] if isinstance(paths, (str, os.PathLike)) else list(paths)
+    folders = {Path(p).parent for p in paths}
+    if len(folders) != 1:
+        raise ValueError(f"inputs {paths} are not in one folder")
+    return folders.pop()
+
+
 def mock_snakemake(rule: str, configfiles: list[str] | None = None, **wildcards):
     """The ``snakemake`` object Snakemake would give the script of ``rule`` for ``wildcards``.
 

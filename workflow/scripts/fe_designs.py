@@ -1,6 +1,6 @@
 """Rule fe_designs: our LHS or the paper's points -> the FE study's designs.parquet."""
 
-from _helpers import mock_snakemake, setup
+from _helpers import folder_of, mock_snakemake, setup
 
 from hdwf.stages.fe import designs_stage
 
@@ -9,4 +9,4 @@ if "snakemake" not in globals():  # run by hand, e.g. to debug one step (see _he
 
 prov = setup(snakemake)
 designs_stage(snakemake.params.designs, snakemake.wildcards.unit, snakemake.input[0],
-              snakemake.params.data_dir, snakemake.output[0], prov)
+              folder_of(snakemake.input[0]), snakemake.output[0], prov)

@@ -1,7 +1,7 @@
 """Rule full_report: every study's and campaign's artefacts -> results/report.pdf."""
 import logging
 
-from _helpers import mock_snakemake, setup
+from _helpers import folder_of, mock_snakemake, setup
 
 from hdwf.stages.report import full_report_stage
 
@@ -10,6 +10,7 @@ if "snakemake" not in globals():  # run by hand, e.g. to debug one step (see _he
 
 prov = setup(snakemake)
 p = snakemake.params
-pdf = full_report_stage(p.studies, p.fe_settings, dict(snakemake.input.items()), p.owners, p.data_dir, prov,
-                        snakemake.output[0])
+artefacts = dict(snakemake.input.items())
+data_dir = folder_of(artefacts.pop("paper_data"))
+pdf = full_report_stage(p.studies, p.fe_settings, artefacts, p.owners, data_dir, prov, snakemake.output[0])
 logging.info("wrote %s", pdf)

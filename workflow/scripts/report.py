@@ -1,7 +1,7 @@
 """Rule study_report: a study's artefacts -> results/{study}/report.pdf."""
 import logging
 
-from _helpers import mock_snakemake, setup
+from _helpers import folder_of, mock_snakemake, setup
 
 from hdwf.stages.report import study_report_stage
 
@@ -10,6 +10,8 @@ if "snakemake" not in globals():  # run by hand, e.g. to debug one step (see _he
 
 prov = setup(snakemake)
 p = snakemake.params
-pdf = study_report_stage(snakemake.wildcards.study, p.study_config, dict(snakemake.input.items()), p.owners,
-                         p.data_dir, prov, snakemake.output[0])
+artefacts = dict(snakemake.input.items())
+data_dir = folder_of(artefacts.pop("paper_data"))
+pdf = study_report_stage(snakemake.wildcards.study, p.study_config, artefacts, p.owners, data_dir, prov,
+                         snakemake.output[0])
 logging.info("wrote %s", pdf)

@@ -1,7 +1,7 @@
 """Rule sobol: surrogate.json -> sobol.parquet (exact + convergence runs) + figure."""
 import logging
 
-from _helpers import mock_snakemake, setup
+from _helpers import folder_of, mock_snakemake, setup
 
 from hdwf import PARAMETERS
 from hdwf.study.paper import table3_bounds
@@ -12,8 +12,8 @@ if "snakemake" not in globals():  # run by hand, e.g. to debug one step (see _he
 
 prov = setup(snakemake)
 w = snakemake.wildcards
-t3 = table3_bounds(snakemake.params.data_dir, w.unit)
-table = sobol_stage(snakemake.input[0], snakemake.output.table, snakemake.output.figure,
+t3 = table3_bounds(folder_of(snakemake.input.bounds), w.unit)
+table = sobol_stage(snakemake.input.surrogate, snakemake.output.table, snakemake.output.figure,
                     snakemake.params.samplers, dict(snakemake.params.settings),
                     f"{w.study} / {w.unit}: Sobol' indices of the surrogate", prov,
                     other_bounds={"table3": ([t3[p][0] for p in PARAMETERS], [t3[p][1] for p in PARAMETERS])})

@@ -12,6 +12,9 @@ from hdwf.common.errors import InputError
 from hdwf.common.io import read_table
 
 FEA_TABLES = {"hd42": "table4_hd42_fea.csv", "hd120": "table5_hd120_fea.csv"}
+# Every file of the paper's data folder this module reads.
+PAPER_TABLES = ("table1_drives.csv", "table2_bearings.csv", "table3_bounds.csv", *FEA_TABLES.values(),
+                "published_statistics.csv")
 _FEA_COLUMNS = {"set": "int", **{c: "float" for c in PARAMETER_COLUMNS}, "lost_motion_arcmin": "float"}
 
 

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import multiprocessing as mp
 import os
+import sys
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -32,6 +33,7 @@ from typing import Callable, Mapping
 
 import numpy as np
 import pandas as pd
+from tqdm import tqdm
 
 from hdwf import PARAMETER_COLUMNS
 from hdwf.drive.design import geometry_of, mesh_design
@@ -60,12 +62,15 @@ class SolveSetup:
         Load steps per ramp of the test 0 → +T → 0 → −T → 0 (4 × this + 1 points).
     jobs : int
         Processes, one specimen each.
+    progress : bool
+        Show a progress bar on stderr while solving (the CLI's commands do; rules log instead).
     """
 
     unit: str
     mesh: Mapping
     steps_per_ramp: int = 5
     jobs: int = 1
+    progress: bool = False
 
 
 def variant_key(effects: dict[str, dict[str, float]]) -> str:
@@ -225,14 +230,23 @@ def solve_specimens(setup: SolveSetup, specimens: pd.DataFrame,
     """
     tasks = [(setup, {"specimen_id": r["specimen_id"], **{c: float(r[c]) for c in PARAMETER_COLUMNS}},
               variants_of(r["specimen_id"])) for _, r in specimens.iterrows()]
-    if setup.jobs <= 1 or len(tasks) <= 1:
-        out = [_specimen_job(t) for t in tasks]
-    else:
-        # fresh interpreters with one BLAS thread each: the dense solves are small, and
-        # 2 processes x 2 BLAS threads on 2 cores only fight
-        with _one_blas_thread(), ProcessPoolExecutor(max_workers=setup.jobs,
-                                                     mp_context=mp.get_context("spawn")) as ex:
-            out = list(ex.map(_specimen_job, tasks))
+    n_solves = sum(len(t[2]) for t in tasks)
+    with tqdm(total=len(tasks), desc=f"{setup.unit}: {n_solves} solves", unit="specimen",
+              disable=not setup.progress, file=sys.stderr) as bar:
+        if setup.jobs <= 1 or len(tasks) <= 1:
+            out = []
+            for t in tasks:
+                out.append(_specimen_job(t))
+                bar.update(1)
+        else:
+            # fresh interpreters with one BLAS thread each: the dense solves are small, and
+            # 2 processes x 2 BLAS threads on 2 cores only fight
+            with _one_blas_thread(), ProcessPoolExecutor(max_workers=setup.jobs,
+                                                         mp_context=mp.get_context("spawn")) as ex:
+                out = []
+                for table in ex.map(_specimen_job, tasks):
+                    out.append(table)
+                    bar.update(1)
     return pd.concat(out, ignore_index=True)
 
 
