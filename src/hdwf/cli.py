@@ -17,6 +17,7 @@ from hdwf.study.paper import paper_measurements
 from hdwf.validation.detectability import plan_detectability
 from hdwf.validation.effects import parse_assignment, registry
 from hdwf.validation.jsonsafe import json_safe
+from hdwf.validation.measurements import MeasurementError, load_measurements
 from hdwf.validation.synthesis import design_ranges, format_ranges, parse_range, synth_designs, synthesize
 from hdwf.validation.variants import SolveSetup
 
@@ -157,6 +158,18 @@ def _paper_measurements(args) -> int:
     return 0
 
 
+def _check_measurements(args) -> int:
+    # every problem on a line of its own, and exit 1: the file is wrong, not the command (that is 2)
+    try:
+        m = load_measurements(args.file, unit=args.unit)
+    except MeasurementError as exc:
+        for line in exc.lines:
+            print(f"hdwf: error: {line}", file=sys.stderr)
+        return 1
+    print(f"{args.file}: {len(m.specimens)} specimens, {len(m.data)} points, form {m.form}: ok")
+    return 0
+
+
 def main(argv=None) -> int:
     """Run the ``hdwf`` command ``argv`` (default: the process's arguments); its exit status."""
     parser = argparse.ArgumentParser(prog="hdwf", description="Harmonic-drive lost-motion study tools.")
@@ -174,6 +187,13 @@ def main(argv=None) -> int:
     p.add_argument("--out", required=True)
     p.add_argument("--force", action="store_true")
     p.set_defaults(func=_paper_measurements)
+    p = sub.add_parser("check-measurements", help="check a measurement file as a campaign for a drive would",
+                       description="Reads a measurement file (docs/measurements.md) with every check of the "
+                                   "loader and of a campaign for --unit, solving nothing; prints one line per "
+                                   "problem and exits 1, or a summary and exits 0.")
+    p.add_argument("file", help="a .csv or .parquet measurement file")
+    p.add_argument("--unit", required=True, choices=["hd42", "hd120"], help="the drive the file is for")
+    p.set_defaults(func=_check_measurements)
     p = sub.add_parser("effects", help="list the candidate physical effects and their parameters")
     p.set_defaults(func=_effects)
     p = sub.add_parser("synth", help="write synthetic lost-motion measurements from the FE model",

@@ -10,6 +10,7 @@ import pytest
 
 from hdwf import __version__
 from hdwf.cli import main
+from hdwf.validation.measurements import load_measurements
 
 from conftest import ROOT
 
@@ -77,3 +78,49 @@ def test_synth_shows_progress_and_writes_the_test_cycle(tmp_path, capsys):
     data = pd.read_csv(out)
     # 0 -> +T -> 0 -> -T -> 0 at 2 steps per ramp: 4 x 2 + 1 points per specimen
     assert data.groupby("specimen_id").size().tolist() == [9, 9]
+    # noise-free data state no uncertainty (zero is refused), so the file loads as it is
+    assert "u_twist_arcmin" not in data and len(load_measurements(out).specimens) == 2
+
+
+DEMO = ROOT / "data" / "validation" / "demo_hd42.csv"
+
+
+def test_check_measurements_of_a_good_file(capsys):
+    assert main(["check-measurements", str(DEMO), "--unit", "hd42"]) == 0
+    out = capsys.readouterr()
+    assert out.out.strip() == f"{DEMO}: 16 specimens, 336 points, form curve: ok" and not out.err
+
+
+def test_check_measurements_prints_every_problem_and_exits_1(tmp_path, capsys):
+    data = pd.read_csv(DEMO)
+    data["u_twist_arcmin"] = data["u_twist_arcmin"].astype(float)
+    data.loc[1, "u_twist_arcmin"] = 0.0                               # row 2
+    data.loc[24, "twist_arcmin"] = 1e9                                # row 25
+    data.loc[42:62, "torque_Nm"] = -data.loc[42:62, "torque_Nm"]      # rows 43-63: hd42-s003 flipped
+    path = tmp_path / "bench.csv"
+    data.to_csv(path, index=False)
+    assert main(["check-measurements", str(path), "--unit", "hd42"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 3 and all(line.startswith(f"hdwf: error: {path}, row ") for line in err), err
+    assert "row 2, field 'u_twist_arcmin', value 0.0: zero uncertainty" in err[0]
+    assert "row 25, field 'twist_arcmin', value 1000000000.0: implausibly large" in err[1]
+    assert "row 43, field 'torque_Nm': specimen 'hd42-s003': twist falls as torque rises" in err[2]
+
+
+@pytest.mark.parametrize("make, says", [
+    (lambda d: DEMO, f"{DEMO}, row 1, field 'unit', value 'hd42': specimen 'hd42-s001' is not of hd120"),
+    (lambda d: d / "missing.csv", "missing.csv: cannot read the measurement file: No such file or directory"),
+    (lambda d: (d / "empty.parquet").write_bytes(b"") or d / "empty.parquet",
+     "empty.parquet: cannot read the measurement file: empty file"),
+])
+def test_check_measurements_refuses_with_exit_1(tmp_path, capsys, make, says):
+    path = make(tmp_path)
+    assert main(["check-measurements", str(path), "--unit", "hd120"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[0].startswith("hdwf: error: ") and says in err[0], err
+
+
+def test_check_measurements_usage_error_exits_2(capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(["check-measurements", str(DEMO), "--unit", "hd50"])
+    assert stop.value.code == 2 and "invalid choice: 'hd50'" in capsys.readouterr().err

@@ -11,16 +11,20 @@ Three forms (``docs/measurements.md``), chosen by the columns present:
 An optional ``u_twist_arcmin`` (curve) or ``u_arcmin`` (phi, lost_motion) column gives the
 standard uncertainty of the measured value. CSV or Parquet by extension. The loader never
 writes to the file; it collects every problem it finds and raises one MeasurementError
-listing them, each with file, row and field.
+listing them, each with file, row and field (the list is in ``docs/measurements.md``, "What is
+checked"). A file that cannot be read at all (missing, empty, not text, not Parquet) is one
+MeasurementError saying why, never a parser's traceback.
 """
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pyarrow as pa
 
 from hdwf import PARAMETER_COLUMNS, PARAMETERS, UNITS
 from hdwf.common.errors import InputError
@@ -33,6 +37,27 @@ FORMS = {
     "lost_motion": ["lost_motion_arcmin"],
 }
 UNCERTAINTY_COLUMN = {"curve": "u_twist_arcmin", "phi": "u_arcmin", "lost_motion": "u_arcmin"}
+# The largest reading the loader believes (arcmin): Φ, φ, φ′, |twist| and a stated uncertainty.
+# A harmonic drive's lost motion is about 0.1-10 arcmin (the paper's Tables 4 and 5: 0.18-2.5;
+# the shipped demo's dead band about 9); 600 arcmin (10°) is far beyond any drive whose teeth
+# still mesh, so a larger value is a unit or typing error (e.g. 1e9), not a measurement.
+READING_LIMIT_ARCMIN = 600.0
+# Quantities that are magnitudes: Φ is the width of the play, φ the twist at +4 % T_N (positive
+# by the sign convention), φ′ the magnitude of the twist at −4 % T_N.
+_NON_NEGATIVE = {
+    "lost_motion_arcmin": "a lost motion is the width of the play",
+    "phi_plus_arcmin": "φ is the twist at +4 % T_N, positive by the sign convention",
+    "phi_minus_arcmin": "φ′ is the magnitude of the twist at −4 % T_N",
+}
+# A curve's twist must rise with torque. It is refused as a flipped sign only when the least-squares
+# slope of twist on torque is this many standard errors below zero: a specimen whose play is lost in
+# the noise can tilt either way by chance (one in a few hundred at 3), a flipped sign tilts by 7 or
+# more (the shipped demo's curves: +7 to +9).
+SIGN_TEST_STANDARD_ERRORS = 3.0
+# A campaign names files after its specimens (hdwf.stages.validation): ids must be safe file names.
+SPECIMEN_ID_PATTERN = r"[A-Za-z0-9_.\-]+"
+# How much of a file is looked at to tell text from binary before parsing it.
+_SNIFF_BYTES = 65536
 # Columns that carry the right quantity in the wrong unit: named so the user knows what to convert.
 _WRONG_UNITS = {
     "torque": ("torque_Nm", ["torque_kNm", "torque_Nmm", "torque_mNm", "torque_lbfin", "torque_ozin", "torque"]),
@@ -91,6 +116,7 @@ class MeasurementError(InputError):
     def __init__(self, file, problems: list[tuple]):
         self.problems = problems
         lines = [str(InputError(file, msg, row=row, field=field, value=value)) for row, field, value, msg in problems]
+        self.lines = lines  # one message per problem, all of them (the message shows the first 25)
         shown = lines[:25] + ([f"... and {len(lines) - 25} more"] if len(lines) > 25 else [])
         super().__init__(file, f"{len(problems)} problem(s):\n  " + "\n  ".join(shown))
 
@@ -110,13 +136,48 @@ class Measurements:
         return sorted(self.specimens["unit"].unique())
 
 
+def _unreadable(path: Path, why: str) -> MeasurementError:
+    return MeasurementError(path, [(None, None, None, why)])
+
+
 def _read_raw(path: Path) -> pd.DataFrame:
+    """The file's table, as text (CSV) or as stored (Parquet); a file that cannot be read is one
+    MeasurementError saying why."""
+    try:
+        with path.open("rb") as fh:
+            head = fh.read(_SNIFF_BYTES)
+    except OSError as exc:  # missing, a directory, no permission: the system's words
+        raise _unreadable(path, f"cannot read the measurement file: {exc.strerror or exc}") from None
     suffix = path.suffix.lower()
-    if suffix == ".csv":
-        return pd.read_csv(path, dtype=str, keep_default_na=False, skipinitialspace=True)
-    if suffix in (".parquet", ".pq"):
+    if suffix not in (".csv", ".parquet", ".pq"):
+        raise _unreadable(path, f"unknown file type '{suffix}': measurement files are .csv or .parquet")
+    if not head:
+        raise _unreadable(path, "cannot read the measurement file: empty file")
+    return _read_csv(path, head) if suffix == ".csv" else _read_parquet(path)
+
+
+def _read_csv(path: Path, head: bytes) -> pd.DataFrame:
+    # NUL never occurs in text; UTF-8 that decodes is not enough (binary can be valid ASCII)
+    if b"\x00" in head:
+        raise _unreadable(path, "cannot read the measurement file: not a text CSV file (it holds NUL bytes)")
+    try:
+        return pd.read_csv(path, dtype=str, keep_default_na=False, skipinitialspace=True, encoding="utf-8")
+    except UnicodeDecodeError:
+        raise _unreadable(path, "cannot read the measurement file: not a text CSV file (not UTF-8; save it "
+                                "as UTF-8 text)") from None
+    except pd.errors.EmptyDataError:
+        raise _unreadable(path, "cannot read the measurement file: empty file (no header line)") from None
+    except pd.errors.ParserError as exc:
+        raise _unreadable(path, f"cannot read the measurement file: malformed CSV: {exc}".strip()) from None
+
+
+def _read_parquet(path: Path) -> pd.DataFrame:
+    try:
         return pd.read_parquet(path)
-    raise InputError(path, f"unknown file type '{suffix}': measurement files are .csv or .parquet")
+    except (OSError, ValueError, pa.ArrowException) as exc:
+        # pyarrow repeats the path ("Could not open Parquet input source '...': why"): keep the why
+        why = str(exc).rsplit("': ", 1)[-1].strip()
+        raise _unreadable(path, f"cannot read the measurement file: not a Parquet file ({why})") from None
 
 
 def _form_of(columns) -> str | None:
@@ -126,13 +187,16 @@ def _form_of(columns) -> str | None:
     return None
 
 
-def load_measurements(path: str | Path) -> Measurements:
+def load_measurements(path: str | Path, unit: str | None = None) -> Measurements:
     """Read and check a measurement file.
 
     Parameters
     ----------
     path : str or Path
         A ``.csv`` or ``.parquet`` file in one of the documented forms.
+    unit : str, optional
+        The drive the file is for (``"hd42"`` or ``"hd120"``), as a campaign has it: every
+        specimen must be of this drive and have an id that can name a file.
 
     Returns
     -------
@@ -141,14 +205,13 @@ def load_measurements(path: str | Path) -> Measurements:
 
     Raises
     ------
-    InputError
-        When the file is missing or of an unknown type.
     MeasurementError
-        Listing every problem found, each with row and field.
+        Listing every problem found, each with file and where known row, field and value; a file
+        that cannot be read (missing, empty, not text, not Parquet, unknown type) is one problem.
     """
     path = Path(path)
-    if not path.exists():
-        raise InputError(path, "file not found")
+    if unit is not None and unit not in UNITS:
+        raise ValueError(f"unknown drive {unit!r}; the model knows {list(UNITS)}")
     raw = _read_raw(path)
     form, problems = _header_problems(list(raw.columns))
     if problems:
@@ -158,6 +221,8 @@ def load_measurements(path: str | Path) -> Measurements:
     data, problems = _typed_data(raw, form)
     problems += _value_problems(data, form)
     problems += _check_specimens(data, form)
+    if unit is not None:
+        problems += _drive_problems(data, unit)
     if problems:
         raise MeasurementError(path, sorted(problems, key=lambda p: (p[0] or 0)))
     specimens = _specimen_table(data, form)
@@ -175,7 +240,7 @@ def _header_problems(cols: list[str]) -> tuple[str | None, list[tuple]]:
     if form is None:
         problems.append((None, "twist_arcmin", None,
                          "no measured quantity: need step, torque_Nm, twist_arcmin (curve), or phi_plus_arcmin, "
-                         "phi_minus_arcmin, or lost_motion_arcmin; found " + ", ".join(cols)))
+                         "phi_minus_arcmin, or lost_motion_arcmin; found " + ", ".join(map(str, cols))))
     for c in ID_COLUMNS:
         if c not in cols:
             problems.append((None, c, None, "missing column"))
@@ -204,7 +269,11 @@ def _typed_data(raw: pd.DataFrame, form: str) -> tuple[pd.DataFrame, list[tuple]
 
 
 def _value_problems(data: pd.DataFrame, form: str) -> list[tuple]:
-    """Parameters outside the model's support and negative uncertainties."""
+    """Parameters outside the model's support, implausible readings and uncertainties."""
+    return _parameter_problems(data) + _reading_problems(data, form) + _uncertainty_problems(data, form)
+
+
+def _parameter_problems(data: pd.DataFrame) -> list[tuple]:
     problems = []
     for i, row in data.iterrows():
         if row["unit"] not in UNITS:
@@ -214,14 +283,50 @@ def _value_problems(data: pd.DataFrame, form: str) -> list[tuple]:
             v = row[c]
             if np.isfinite(v) and not lo - 1e-12 <= v <= hi + 1e-12:
                 problems.append((i + 1, c, v, f"outside what the model supports for {row['unit']}: [{lo:g}, {hi:g}] mm"))
-    ucol = UNCERTAINTY_COLUMN[form]
-    if ucol in data:
-        for i in np.flatnonzero((data[ucol] < 0).to_numpy()):
-            problems.append((i + 1, ucol, data[ucol].iloc[i], "an uncertainty cannot be negative"))
     return problems
 
 
+def _rows_where(data: pd.DataFrame, c: str, bad: np.ndarray, msg: str) -> list[tuple]:
+    return [(i + 1, c, data[c].iloc[i], msg) for i in np.flatnonzero(bad)]
+
+
+def _too_large(what: str = "") -> str:
+    return (f"implausibly large{what}: beyond {READING_LIMIT_ARCMIN:g} arcmin (10°), where a harmonic drive's "
+            "lost motion is 0.1-10 arcmin (a unit or typing error?)")
+
+
+def _reading_problems(data: pd.DataFrame, form: str) -> list[tuple]:
+    """Non-integer steps, negative magnitudes and readings beyond ``READING_LIMIT_ARCMIN``."""
+    problems = []
+    for c in FORMS[form]:
+        v = data[c].to_numpy(float)
+        finite = np.isfinite(v)
+        if c == "step":
+            problems += _rows_where(data, c, finite & (v != np.round(v)),
+                                    "a step is a whole number: the order of the point in the test")
+        elif c in _NON_NEGATIVE:
+            problems += _rows_where(data, c, finite & (v < 0), f"cannot be negative: {_NON_NEGATIVE[c]}")
+            problems += _rows_where(data, c, finite & (v > READING_LIMIT_ARCMIN), _too_large())
+        elif c == "twist_arcmin":
+            problems += _rows_where(data, c, finite & (np.abs(v) > READING_LIMIT_ARCMIN), _too_large(" |twist|"))
+        # torque_Nm has a bound of its own, the drive's test torque (_curve_problems)
+    return problems
+
+
+def _uncertainty_problems(data: pd.DataFrame, form: str) -> list[tuple]:
+    ucol = UNCERTAINTY_COLUMN[form]
+    if ucol not in data:
+        return []
+    u = data[ucol].to_numpy(float)
+    return (_rows_where(data, ucol, u < 0, "an uncertainty cannot be negative")
+            + _rows_where(data, ucol, u == 0, "zero uncertainty: every reading has a non-zero uncertainty; "
+                                              "give the bench's standard uncertainty, or leave the column out")
+            + _rows_where(data, ucol, np.isfinite(u) & (u > READING_LIMIT_ARCMIN), _too_large(" uncertainty")))
+
+
 def _check_specimens(data: pd.DataFrame, form: str) -> list[tuple]:
+    """Per specimen: the same drive and parameters on every row; one row each (phi,
+    lost_motion) or a well-formed curve."""
     problems = []
     for sid, rows in data.groupby("specimen_id", sort=False):
         first = rows.index[0]
@@ -230,24 +335,67 @@ def _check_specimens(data: pd.DataFrame, form: str) -> list[tuple]:
             for i in differs:
                 problems.append((i + 1, c, data.at[i, c], f"specimen '{sid}' changes {c} between rows "
                                                           f"(row {first + 1} has {rows[c].iloc[0]!r})"))
-        if form != "curve":
+        if form == "curve":
+            problems += _curve_problems(data, sid, rows)
+        else:
             for i in rows.index[1:]:
                 problems.append((i + 1, "specimen_id", sid, f"specimen '{sid}' appears twice; give one row per specimen"))
-            continue
-        steps = rows["step"]
-        for i in rows.index[steps.duplicated().to_numpy()]:
-            problems.append((i + 1, "step", data.at[i, "step"], f"duplicate step in specimen '{sid}'"))
-        unit = rows["unit"].iloc[0]
-        if unit in UNITS and np.isfinite(rows["torque_Nm"]).all():
-            t = rows.sort_values("step")["torque_Nm"].to_numpy()
-            test = lost_motion_test_torque_Nm(unit)
-            if t.max() <= 0 or t.min() >= 0:
-                problems.append((first + 1, "torque_Nm", None, f"specimen '{sid}' does not load in both directions "
-                                                               "(the test is 0 → +4 % T_N → 0 → −4 % T_N → 0)"))
-            big = np.abs(t) > 1.5 * test
-            for i in rows.sort_values("step").index[big]:
-                problems.append((i + 1, "torque_Nm", data.at[i, "torque_Nm"],
-                                 f"beyond 1.5 × the test torque ±{test:g} N·m of {unit} (wrong unit?)"))
+    return problems
+
+
+def _curve_problems(data: pd.DataFrame, sid: str, rows: pd.DataFrame) -> list[tuple]:
+    """Duplicate steps, a test that does not load both ways, torque beyond the test, a flipped sign."""
+    problems = []
+    first = rows.index[0]
+    for i in rows.index[rows["step"].duplicated().to_numpy()]:
+        problems.append((i + 1, "step", data.at[i, "step"], f"duplicate step in specimen '{sid}'"))
+    unit = rows["unit"].iloc[0]
+    if unit not in UNITS or not np.isfinite(rows["torque_Nm"]).all():
+        return problems
+    t = rows.sort_values("step")["torque_Nm"].to_numpy()
+    test = lost_motion_test_torque_Nm(unit)
+    if t.max() <= 0 or t.min() >= 0:
+        problems.append((first + 1, "torque_Nm", None, f"specimen '{sid}' does not load in both directions "
+                                                       "(the test is 0 → +4 % T_N → 0 → −4 % T_N → 0)"))
+    big = np.abs(t) > 1.5 * test
+    for i in rows.sort_values("step").index[big]:
+        problems.append((i + 1, "torque_Nm", data.at[i, "torque_Nm"],
+                         f"beyond 1.5 × the test torque ±{test:g} N·m of {unit} (wrong unit?)"))
+    return problems + _sign_problems(sid, rows)
+
+
+def _sign_problems(sid: str, rows: pd.DataFrame) -> list[tuple]:
+    """Twist that falls as torque rises: the least-squares slope of twist on torque over the
+    specimen's points, ``SIGN_TEST_STANDARD_ERRORS`` standard errors below zero."""
+    t, w = rows["torque_Nm"].to_numpy(float), rows["twist_arcmin"].to_numpy(float)
+    if not (np.isfinite(t).all() and np.isfinite(w).all()):
+        return []
+    x = t - t.mean()
+    sxx = float(x @ x)
+    if sxx == 0.0:  # one torque only: "does not load in both directions" says it
+        return []
+    slope = float(x @ (w - w.mean())) / sxx
+    resid = w - w.mean() - slope * x
+    se = float(np.sqrt(resid @ resid / (len(t) - 2) / sxx)) if len(t) > 2 else 0.0
+    if slope + SIGN_TEST_STANDARD_ERRORS * se >= 0:
+        return []
+    how = f"{-slope / se:.1f} standard errors below zero" if se > 0 else "exactly"
+    return [(rows.index[0] + 1, "torque_Nm", None,
+             f"specimen '{sid}': twist falls as torque rises (least-squares slope {slope:.3g} arcmin/N·m, {how}); "
+             "positive torque gives positive twist, so a sign is flipped (of torque_Nm or of twist_arcmin)")]
+
+
+def _drive_problems(data: pd.DataFrame, unit: str) -> list[tuple]:
+    """What a campaign for ``unit`` needs: every specimen of that drive, ids that can name a file."""
+    problems = []
+    for sid, rows in data.groupby("specimen_id", sort=False):
+        first = rows.index[0]
+        if rows["unit"].iloc[0] in UNITS and rows["unit"].iloc[0] != unit:  # an unknown drive is named already
+            problems.append((first + 1, "unit", rows["unit"].iloc[0], f"specimen '{sid}' is not of {unit}, "
+                                                                      "the drive these measurements are for"))
+        if sid and not re.fullmatch(SPECIMEN_ID_PATTERN, sid):
+            problems.append((first + 1, "specimen_id", sid, "specimen ids may use letters, digits, '_', '.' and '-' "
+                                                            "only (a campaign names files after them)"))
     return problems
 
 

@@ -192,14 +192,17 @@ def add_noise(curves: pd.DataFrame, noise_arcmin: float, seed: int) -> pd.DataFr
     Returns
     -------
     pandas.DataFrame
-        The curve form of a measurement file, with ``u_twist_arcmin`` = ``noise_arcmin``.
+        The curve form of a measurement file, with ``u_twist_arcmin`` = ``noise_arcmin``; without
+        that column for noise-free data (a stated uncertainty must be above zero).
     """
     rng = np.random.default_rng(seed)
     data = curves.copy()
     data["twist_arcmin"] = data["twist_arcmin"] + rng.normal(0.0, noise_arcmin, len(data))
-    data["u_twist_arcmin"] = noise_arcmin
-    return data[["specimen_id", "unit", *PARAMETER_COLUMNS, "step", "torque_Nm", "twist_arcmin",
-                 "u_twist_arcmin"]]
+    columns = ["specimen_id", "unit", *PARAMETER_COLUMNS, "step", "torque_Nm", "twist_arcmin"]
+    if noise_arcmin > 0:
+        data["u_twist_arcmin"] = noise_arcmin
+        columns.append("u_twist_arcmin")
+    return data[columns]
 
 
 def synthesize(setup: SolveSetup, n_designs: int, seed: int, noise_arcmin: float,
