@@ -25,7 +25,21 @@ from hdwf.validation.variants import SolveSetup
 def _check_config(args) -> int:
     config = load_config(args.config, args.schema)
     print(f"{args.config}: valid; config hash {config_hash(config)}")
-    return 0
+    # each campaign's measurement file as the workflow will read it, before any solve
+    root = Path(args.config).resolve().parent
+    failed = False
+    for name, camp in config.get("validation", {}).items():
+        path = root / camp["measurements"]
+        try:
+            m = load_measurements(path, unit=camp["unit"])
+        except MeasurementError as exc:
+            failed = True
+            for line in exc.lines:
+                print(f"hdwf: error: campaign '{name}': {line}", file=sys.stderr)
+            continue
+        print(f"campaign '{name}': {camp['measurements']}: {len(m.specimens)} specimens of {camp['unit']}, "
+              f"form {m.form}: ok")
+    return 1 if failed else 0
 
 
 def _provenance(args) -> int:

@@ -124,3 +124,21 @@ def test_check_measurements_usage_error_exits_2(capsys):
     with pytest.raises(SystemExit) as stop:
         main(["check-measurements", str(DEMO), "--unit", "hd50"])
     assert stop.value.code == 2 and "invalid choice: 'hd50'" in capsys.readouterr().err
+
+
+def test_check_config_checks_every_campaign_file(tmp_path, capsys):
+    project = tmp_path / "project"
+    (project / "data/validation").mkdir(parents=True)
+    config = (ROOT / "config.yaml").read_text()
+    (project / "config.yaml").write_text(config)
+    for f in (ROOT / "data/validation").glob("*.csv"):
+        (project / "data/validation" / f.name).write_bytes(f.read_bytes())
+    assert main(["check-config", str(project / "config.yaml")]) == 0
+    out = capsys.readouterr().out
+    assert "campaign 'demo': data/validation/demo_hd42.csv: 16 specimens of hd42, form curve: ok" in out
+    demo = pd.read_csv(project / "data/validation/demo_hd42.csv")
+    demo.loc[4, "twist_arcmin"] = -1e9
+    demo.to_csv(project / "data/validation/demo_hd42.csv", index=False)
+    assert main(["check-config", str(project / "config.yaml")]) == 1
+    err = capsys.readouterr().err
+    assert "campaign 'demo'" in err and "row 5, field 'twist_arcmin', value -1000000000.0" in err

@@ -6,13 +6,11 @@ Each stage reads its inputs, calls ``hdwf.validation`` and writes what its rule 
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
 
-from hdwf.common.errors import InputError
 from hdwf.common.io import read_json, write_json, write_parquet
 from hdwf.report.figures import ladder_figure, measured_vs_predicted_figure, residual_figure
 from hdwf.validation.diagnosis import Search, diagnose
@@ -116,17 +114,9 @@ def campaign_specimens(plan: CampaignPlan) -> pd.DataFrame:
     ------
     InputError
         For every problem of the file (with file, row and field), a specimen of another drive
-        or a specimen id that cannot name a file.
+        or a specimen id that cannot name a file (``load_measurements`` with the campaign's drive).
     """
-    spec = load_measurements(plan.measurements).specimens
-    for i, r in spec.iterrows():
-        if r["unit"] != plan.unit:
-            raise InputError(plan.measurements, f"campaign '{plan.name}' is for {plan.unit}",
-                             field="unit", value=r["unit"], row=int(i) + 1)
-        if not re.fullmatch(r"[A-Za-z0-9_.\-]+", str(r["specimen_id"])):
-            raise InputError(plan.measurements, "specimen ids may use letters, digits, '_', '.' and '-' only",
-                             field="specimen_id", value=r["specimen_id"], row=int(i) + 1)
-    return spec
+    return load_measurements(plan.measurements, unit=plan.unit).specimens
 
 
 def specimen_record(specimens: pd.DataFrame, specimen_id: str) -> dict:
