@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import os
 import sys
@@ -13,6 +14,7 @@ from hdwf.common.errors import InputError
 from hdwf.common.io import atomic_path
 from hdwf.common.provenance import config_hash, provenance
 from hdwf.config import SCHEMA_PATH, load_config
+from hdwf.stages.validation import campaign_plan, campaign_specimens
 from hdwf.study.paper import paper_measurements
 from hdwf.validation.detectability import plan_detectability
 from hdwf.validation.effects import parse_assignment, registry
@@ -29,16 +31,15 @@ def _check_config(args) -> int:
     root = Path(args.config).resolve().parent
     failed = False
     for name, camp in config.get("validation", {}).items():
-        path = root / camp["measurements"]
+        plan = campaign_plan(name, camp, config["fe"])
         try:
-            m = load_measurements(path, unit=camp["unit"])
+            specimens = campaign_specimens(dataclasses.replace(plan, measurements=str(root / plan.measurements)))
         except MeasurementError as exc:
             failed = True
             for line in exc.lines:
                 print(f"hdwf: error: campaign '{name}': {line}", file=sys.stderr)
             continue
-        print(f"campaign '{name}': {camp['measurements']}: {len(m.specimens)} specimens of {camp['unit']}, "
-              f"form {m.form}: ok")
+        print(f"campaign '{name}': {plan.measurements}: {len(specimens)} specimens of {plan.unit}: ok")
     return 1 if failed else 0
 
 

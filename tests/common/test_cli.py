@@ -135,7 +135,7 @@ def test_check_config_checks_every_campaign_file(tmp_path, capsys):
         (project / "data/validation" / f.name).write_bytes(f.read_bytes())
     assert main(["check-config", str(project / "config.yaml")]) == 0
     out = capsys.readouterr().out
-    assert "campaign 'demo': data/validation/demo_hd42.csv: 16 specimens of hd42, form curve: ok" in out
+    assert "campaign 'demo': data/validation/demo_hd42.csv: 16 specimens of hd42: ok" in out
     demo = pd.read_csv(project / "data/validation/demo_hd42.csv")
     demo.loc[4, "twist_arcmin"] = -1e9
     demo.to_csv(project / "data/validation/demo_hd42.csv", index=False)

@@ -7,7 +7,8 @@ import pandas as pd
 import pytest
 
 from hdwf.study.paper import paper_measurements
-from hdwf.validation.measurements import READING_LIMIT_ARCMIN, MeasurementError, load_measurements
+from hdwf.validation.measurements import (READING_LIMIT_ARCMIN, MeasurementError, load_measurements,
+                                         schedule_problems)
 
 from conftest import DATA, ROOT
 
@@ -181,3 +182,28 @@ def test_a_campaign_for_one_drive_refuses_other_drives_and_bad_ids(tmp_path):
     assert f"{path}, row 1, field 'unit', value 'hd42': specimen 'S1' is not of hd120" in lines[0]
     assert any(s.startswith(f"{path}, row 10, field 'specimen_id', value 'S 2': specimen ids may use") for s in lines)
     assert len(lines) == 3, lines
+
+
+def test_a_campaign_whose_load_steps_do_not_match_the_data_stops_before_any_solve(tmp_path):
+    """The demo curves have 21 points (5 steps per ramp): the campaign's test must match them
+    step by step, else the measured point would be compared with another torque's model point."""
+    demo = load_measurements(SHIPPED / "demo_hd42.csv")
+    assert schedule_problems(demo, 5) == []
+    problems = schedule_problems(demo, 4)         # 17 steps: steps 17-20 do not exist, the rest mismatch
+    fields = {p[1] for p in problems}
+    assert fields == {"step", "torque_Nm"}
+    beyond = [p for p in problems if p[1] == "step"]
+    assert len(beyond) == 16 * 4 and {p[2] for p in beyond} == {17, 18, 19, 20}
+    assert "steps_per_ramp" in beyond[0][3]
+
+
+def test_a_test_run_minus_T_first_is_refused_with_the_reason(tmp_path):
+    data = pd.read_csv(SHIPPED / "demo_hd42.csv")
+    data["torque_Nm"] = -data["torque_Nm"]
+    data["twist_arcmin"] = -data["twist_arcmin"]      # a consistent test, loaded -T first
+    path = tmp_path / "minus_first.csv"
+    data.to_csv(path, index=False)
+    problems = schedule_problems(load_measurements(path), 5)   # the file itself is fine
+    first = min(problems, key=lambda p: p[0])
+    assert first[:3] == (2, "torque_Nm", data["torque_Nm"][1])  # step 1 of the first specimen
+    assert "−T first" in first[3] and "+0.192 N·m at step 1" in first[3]

@@ -37,11 +37,12 @@ a temperature difference and Oldham play are off in the baseline (``ModelChanges
 from hdwf.fe.bodies import assemble_stiffness, edge_loads, plane_stress_lame, solve_linear
 from hdwf.fe.changes import ModelChanges
 from hdwf.fe.cycle import (LostMotionResult, series_output_twist, solve_lost_motion,
-                           solve_lost_motion_variants)
+                           solve_lost_motion_variants, torque_fractions)
 from hdwf.fe.hertz import ball_compliance_coeff, hertz_point_contact
 from hdwf.fe.model import LostMotionModel
 from hdwf.fe.solver import ContactFailure
 
 __all__ = ["ContactFailure", "LostMotionModel", "LostMotionResult", "ModelChanges", "assemble_stiffness",
            "ball_compliance_coeff", "edge_loads", "hertz_point_contact", "plane_stress_lame",
-           "series_output_twist", "solve_linear", "solve_lost_motion", "solve_lost_motion_variants"]
+           "series_output_twist", "solve_linear", "solve_lost_motion", "solve_lost_motion_variants",
+           "torque_fractions"]

@@ -114,8 +114,9 @@ def series_output_twist(rim_twist_rad: np.ndarray, torque_Nmm: np.ndarray,
     return out
 
 
-def _load_path(steps_per_ramp: int) -> np.ndarray:
-    """Torque fractions 0 -> 1 -> 0 -> -1 -> 0 in ``steps_per_ramp`` steps per ramp."""
+def torque_fractions(steps_per_ramp: int) -> np.ndarray:
+    """The test's torque at each step, as a fraction of the test torque: 0 -> 1 -> 0 -> -1 -> 0
+    in ``steps_per_ramp`` steps per ramp (4 x ``steps_per_ramp`` + 1 steps)."""
     n = steps_per_ramp
     up = np.linspace(0, 1, n + 1)
     return np.concatenate([up, up[::-1][1:], -up[1:], -up[::-1][1:]])
@@ -287,7 +288,7 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
     """
     changes = ModelChanges() if changes is None else changes
     t0 = time.perf_counter()
-    frac = _load_path(steps_per_ramp)
+    frac = torque_fractions(steps_per_ramp)
     model = None
     try:
         model = LostMotionModel(geom, mesh, E=E, max_iter=max_iter, tol_gap=tol_gap,
@@ -326,7 +327,7 @@ def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_r
         One per variant, in order.
     """
     t0 = time.perf_counter()
-    frac = _load_path(steps_per_ramp)
+    frac = torque_fractions(steps_per_ramp)
     base = None
     try:
         base = LostMotionModel(geom, mesh)

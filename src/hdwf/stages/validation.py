@@ -16,7 +16,7 @@ from hdwf.report.figures import ladder_figure, measured_vs_predicted_figure, res
 from hdwf.validation.diagnosis import Search, diagnose
 from hdwf.validation.jsonsafe import json_safe
 from hdwf.validation.ladder import ladder_variants, solve_ladder
-from hdwf.validation.measurements import load_measurements
+from hdwf.validation.measurements import MeasurementError, load_measurements, schedule_problems
 from hdwf.validation.variants import SolveSetup, candidate_names, plan_variants, solve_specimen, specimen_solver
 
 
@@ -114,9 +114,14 @@ def campaign_specimens(plan: CampaignPlan) -> pd.DataFrame:
     ------
     InputError
         For every problem of the file (with file, row and field), a specimen of another drive
-        or a specimen id that cannot name a file (``load_measurements`` with the campaign's drive).
+        or a specimen id that cannot name a file (``load_measurements`` with the campaign's drive),
+        and curve points the campaign's test has no match for (``schedule_problems``).
     """
-    return load_measurements(plan.measurements, unit=plan.unit).specimens
+    meas = load_measurements(plan.measurements, unit=plan.unit)
+    problems = schedule_problems(meas, plan.steps_per_ramp)
+    if problems:
+        raise MeasurementError(plan.measurements, problems)
+    return meas.specimens
 
 
 def specimen_record(specimens: pd.DataFrame, specimen_id: str) -> dict:

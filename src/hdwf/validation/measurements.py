@@ -28,6 +28,7 @@ import pyarrow as pa
 
 from hdwf import PARAMETER_COLUMNS, PARAMETERS, UNITS
 from hdwf.common.errors import InputError
+from hdwf.fe import torque_fractions
 from hdwf.drive.geometry import unit_data
 
 ID_COLUMNS = ["specimen_id", "unit", *PARAMETER_COLUMNS]
@@ -409,3 +410,44 @@ def _specimen_table(data: pd.DataFrame, form: str) -> pd.DataFrame:
         spec = spec.merge(data.groupby("specimen_id", sort=False)[["lost_motion_arcmin"]].first().reset_index(),
                           on="specimen_id")
     return spec
+
+
+def schedule_problems(meas: Measurements, steps_per_ramp: int) -> list[tuple]:
+    """Curve points the model's test has no match for, found before any solve.
+
+    A curve is compared with the model step by step; the model loads 0 → +T → 0 → −T → 0 in
+    ``steps_per_ramp`` steps per ramp (``hdwf.fe.torque_fractions``). A measured step outside
+    that test, or at a torque more than a quarter of a load step from the model's torque at the
+    same step (another number of steps per ramp, a test run −T first), would be compared with
+    the wrong model point.
+
+    Parameters
+    ----------
+    meas : Measurements
+        A checked file (``load_measurements``); only the curve form has steps.
+    steps_per_ramp : int
+        The campaign's load steps per ramp.
+
+    Returns
+    -------
+    list of tuple
+        ``(row, field, value, message)`` per problem, as ``MeasurementError`` takes them.
+    """
+    if meas.form != "curve":
+        return []
+    fractions = torque_fractions(steps_per_ramp)
+    problems = []
+    for i, row in meas.data.iterrows():
+        step, torque, test = int(row["step"]), float(row["torque_Nm"]), lost_motion_test_torque_Nm(row["unit"])
+        if not 0 <= step < len(fractions):
+            problems.append((i + 1, "step", step, f"not a step of the campaign's test (steps 0-{len(fractions) - 1} at "
+                                                  f"steps_per_ramp {steps_per_ramp}); set the campaign's steps_per_ramp "
+                                                  "to match the data"))
+            continue
+        model = fractions[step] * test
+        if abs(torque - model) > 0.25 * test / steps_per_ramp:
+            problems.append((i + 1, "torque_Nm", torque,
+                             f"the campaign's test (0 → +T → 0 → −T → 0, steps_per_ramp {steps_per_ramp}) is at "
+                             f"{model:+.4g} N·m at step {step}: another number of steps per ramp, or a test run −T "
+                             "first? set the campaign's steps_per_ramp, or number the steps in the model's order"))
+    return problems
