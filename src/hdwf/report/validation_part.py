@@ -132,6 +132,55 @@ def _where_it_fails(doc: Document, diag: dict, campaign: CampaignArtefacts, leve
     doc.figure(campaign.residuals_png, "Residuals D − S against each input (specimen means) and along the test.")
 
 
+_TERM_LABELS = {"bias": "level bias", "slope": "slope on torque (compliance)",
+                "dead_band": "dead band at zero torque (play width)", "loop_width": "loop width between branches"}
+
+
+def _signature_rows(sig: dict) -> list[list[str]]:
+    """Per term of the residual's signature: its value (also in arcmin), se and significance; then the noise."""
+    rows = []
+    for t in sig["terms"]:
+        label = _TERM_LABELS.get(t["name"]) or f"trend with {t['name'].removeprefix('trend_')}"
+        value = f"{fmt(t['value'], 4)} {t['unit']}"
+        if t["unit"] != "arcmin":
+            value += f" ({fmt(t['value_arcmin'], 4)} arcmin)"
+        if t.get("r_squared") is not None:
+            value += f", R² {t['r_squared']:.2f}"
+        rows.append([lit(label), lit(value), lit(f"{fmt(t['se'], 4)} {t['unit']}"),
+                     "yes" if t["significant"] else "no"])
+    n = sig["noise"]
+    stated = n.get("stated_median_arcmin")
+    rows.append(["noise: stated (median u)", "none" if stated is None else f"{fmt(stated, 4)} arcmin", "–", "–"])
+    rows.append(["noise: from the data", "–" if n.get("estimate_arcmin") is None else
+                 f"{fmt(n['estimate_arcmin'], 4)} arcmin", "–", "flagged" if n["flag"] else "–"])
+    return rows
+
+
+def signature_section(doc: Document, diag: dict) -> None:
+    """What the campaign model's residual looks like (``diagnosis.json``: signature): a table of its
+    terms and the verdict in one sentence. Nothing is added when the diagnosis has no signature.
+
+    Parameters
+    ----------
+    doc
+        The document to add to.
+    diag
+        The campaign's ``diagnosis.json``.
+    """
+    sig = diag.get("signature")
+    if not sig:
+        return
+    doc.table(["residual signature", "value", "uncertainty (1 se)", "significant?"], _signature_rows(sig),
+              f"Residual signature: the campaign model's residual D − S (measured minus model) split into terms; "
+              f"significant beyond {fmt(sig['significant_z'], 1)} standard errors. Trends: the per-specimen mean "
+              "residual against each input (in arcmin across the specimens' range). Noise from the data: "
+              f"{lit(sig['noise']['estimate_from'])}.")
+    if sig["noise"]["flag"]:
+        doc.text(f"Caution: {lit(sig['noise']['note'])}.")
+    if sig.get("text"):
+        doc.text(f"In one sentence: {lit(sig['text'])}.")
+
+
 def _round_table(doc: Document, rnd: dict) -> None:
     """Every candidate of one round, calibrated on top of that round's model."""
     cur = "the campaign's model" if not rnd["model_effects"] else "the model with " + ", ".join(
@@ -188,6 +237,7 @@ def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2)
     doc.heading(f"Campaign '{campaign.name}' ({UNIT_NAMES[diag['unit']]})", level)
     _campaign_intro(doc, diag)
     _where_it_fails(doc, diag, campaign, level + 1)
+    signature_section(doc, diag)
     doc.heading("Which effect is missing", level + 1)
     for rnd in diag["rounds"]:
         _round_table(doc, rnd)

@@ -40,6 +40,7 @@ from hdwf.validation.detectability import Visibility, detectability
 from hdwf.validation.effects import get as get_effect
 from hdwf.validation.measurements import Measurements
 from hdwf.validation.observations import observation_frame, predict, prediction_points
+from hdwf.validation.signature import ResidualSignature, residual_signature, with_verdict
 from hdwf.validation.variants import candidate_names, variant_key
 
 
@@ -143,6 +144,7 @@ class Diagnosis:
     residual_tests: pd.DataFrame
     # one row per observation: measured D, the campaign model S_model and the final model S_final
     points: pd.DataFrame
+    signature: ResidualSignature   # what the campaign model's residual D - S looks like
 
     @property
     def found_in_order(self) -> list[str]:
@@ -180,6 +182,7 @@ class Diagnosis:
             "worst_specimens": self.per_specimen.head(5).to_dict(orient="records"),
             "per_specimen": self.per_specimen.to_dict(orient="records"),
             "residual_tests": self.residual_tests.to_dict(orient="records"),
+            "signature": self.signature.to_dict(),
         }
 
 
@@ -300,6 +303,17 @@ def _noise(obs: pd.DataFrame, g: _GreedySearch) -> tuple[float | None, float, st
     return None, sigma, "the residual of the final model (no noise stated: an upper bound on the noise)"
 
 
+def _signature(form: str, base_points: pd.DataFrame, g: _GreedySearch) -> ResidualSignature:
+    """The signature of the campaign model's residual, its text naming what the search found (or
+    the closest candidate of round 1 when it found nothing)."""
+    found = [e for e in g.on if e not in g.search.calibrate_first]
+    first = g.rounds[0]
+    closest = first.verdict.ranking[0] if first.verdict.ranking and not found else None
+    at_bound = closest is not None and first.evidence[closest.effect].at_bound
+    return with_verdict(residual_signature(base_points, form), found, float(np.sqrt(g.fit.rss / len(g.data.D))),
+                        closest, at_bound, first.current_rmse_arcmin)
+
+
 def _diagnosis(meas: Measurements, obs: pd.DataFrame, g: _GreedySearch, table_resp: dict[str, Response],
                notes: dict[str, str]) -> Diagnosis:
     """The result of a finished search."""
@@ -321,7 +335,8 @@ def _diagnosis(meas: Measurements, obs: pd.DataFrame, g: _GreedySearch, table_re
         rounds=g.rounds, found=found, final_effects=fit.params(resp),
         final_rmse_arcmin=float(np.sqrt(fit.rss / n)),
         detectability=DataDetectability(sigma, sigma_from, pay, seen), notes=notes, refinement=g.refinement,
-        per_specimen=per, residual_tests=tests, points=_points(meas, obs, g.data.S0, fit.S, base_points))
+        per_specimen=per, residual_tests=tests, points=_points(meas, obs, g.data.S0, fit.S, base_points),
+        signature=_signature(meas.form, base_points, g))
 
 
 def diagnose(meas: Measurements, table: pd.DataFrame, search: Search | None = None,
