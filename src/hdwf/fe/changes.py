@@ -32,13 +32,21 @@ class ModelChanges:
       and the output where the twist is measured (the FS cup and diaphragm).
     * ``output_play_rad``: a dead band in series in the output chain (e.g. the wave
       generator's Oldham coupling, seen at the output).
+    * ``output_microslip_loop_rad``: a micro-slip (Iwan) element in series in the output
+      chain, given by the width w (rad) of the hysteresis loop it opens at zero torque in the
+      lost-motion test 0 -> +T -> 0 -> -T -> 0.  It is the Iwan/Masing element (springs
+      bridged by Coulomb sliders, the compliance spread evenly over their slip torques) of
+      density a = 2 w / T^2, T the peak torque of the path (the test torque); its twist
+      follows the load path with the Masing rule (``hdwf.fe.cycle.microslip_twist``).
     """
     flank_friction: float = 0.0
     cs_rim_stiffness_N_mm2: float = math.inf
     cs_scale: float = 1.0
     output_compliance_rad_per_Nmm: float = 0.0
     output_play_rad: float = 0.0
+    output_microslip_loop_rad: float = 0.0
 
     def fe_part(self) -> "ModelChanges":
         """The changes that need a new contact solve: all but the series elements."""
-        return replace(self, output_compliance_rad_per_Nmm=0.0, output_play_rad=0.0)
+        return replace(self, output_compliance_rad_per_Nmm=0.0, output_play_rad=0.0,
+                       output_microslip_loop_rad=0.0)

@@ -418,10 +418,22 @@ def residual_signature(points: pd.DataFrame, form: str) -> ResidualSignature:
     return replace(sig, text=describe(sig))
 
 
-def _phrase(t: SignatureTerm) -> str:
+def _dominant_phrase(sig: ResidualSignature, dom: SignatureTerm) -> str:
+    """The dominant term in words. A wider gap at zero torque whose branches stay apart under load
+    too is a hysteresis loop, not play: a dead band closes as soon as the torque is non-zero."""
+    loop = next((t for t in sig.terms if t.name == "loop_width"), None)
+    if dom.name == "dead_band" and dom.value > 0 and loop is not None and loop.significant and loop.value > 0:
+        return (f"a hysteresis loop {_phrase(dom, bare=True)} arcmin wide at zero torque whose branches stay "
+                f"{_phrase(loop, bare=True)} arcmin apart under load (play would close under load)")
+    return _phrase(dom)
+
+
+def _phrase(t: SignatureTerm, bare: bool = False) -> str:
     """A term in words, for the verdict: the value to the decimals of its se's two leading digits."""
     key = "trend" if t.name.startswith("trend_") else t.name
     dec = min(max(1 - math.floor(math.log10(t.se)), 0), 8) if math.isfinite(t.se) and t.se > 0 else 4
+    if bare:  # value ± se only
+        return f"{t.value:.{dec}f} ± {t.se:.2g}"
     return _PHRASES[key].format(v=f"{t.value:.{dec}f}", se=f"{t.se:.2g}", va=f"{t.value_arcmin:.3g}",
                                 p=t.name.removeprefix("trend_"))
 
@@ -459,7 +471,7 @@ def describe(sig: ResidualSignature, found: list[str] | None = None, final_rmse_
         word = "fails" if ratio > FAILS_RATIO else f"fits to within {FAILS_RATIO:g}× the noise"
         parts = [f"the model {word} (RMSE {ratio:.3g}× the noise)"]
     dom = sig.term(sig.dominant) if sig.dominant else None
-    parts.append(f"the residual's clearest component is {_phrase(dom)}" if dom else
+    parts.append(f"the residual's clearest component is {_dominant_phrase(sig, dom)}" if dom else
                  f"no component of the residual stands out from the noise (none beyond {SIGNIFICANT_Z:g} se)")
     if found:
         end = f" (RMSE {sig.rmse_arcmin:.4g} → {final_rmse_arcmin:.4g} arcmin)" if final_rmse_arcmin is not None else ""
