@@ -1,5 +1,7 @@
 from pathlib import Path
 
+import numpy as np
+import pandas as pd
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -16,3 +18,30 @@ def pytest_collection_modifyitems(items):
     for item in items:
         if item.get_closest_marker("e2e"):
             item.add_marker(pytest.mark.slow)
+
+
+def write_table(df: pd.DataFrame, tmp_path, name: str = "m.csv") -> Path:
+    """``df`` written to ``tmp_path / name``, CSV or Parquet by the name's extension."""
+    path = tmp_path / name
+    if name.endswith(".csv"):
+        df.to_csv(path, index=False)
+    else:
+        df.to_parquet(path, index=False)
+    return path
+
+
+def masing_loop(T: np.ndarray, loop: float) -> np.ndarray:
+    """A Masing hysteresis loop along a torque path, written out branch by branch (independent of
+    the effect's code in hdwf.fe.cycle): virgin curve c T|T|, after a reversal at (T_r, θ_r)
+    θ_r + c (T - T_r)|T - T_r| / 2, c = loop / T_max², so in the test 0 -> +T -> 0 -> -T -> 0
+    the branches are ``loop`` apart at zero torque."""
+    c = loop / np.max(np.abs(T)) ** 2
+    out, t_r, th_r, virgin, d_prev = [], 0.0, 0.0, True, 0.0
+    for k, t in enumerate(T):
+        if k:
+            d = np.sign(t - T[k - 1])
+            if d_prev and d and d != d_prev:
+                t_r, th_r, virgin = T[k - 1], out[-1], False
+            d_prev = d or d_prev
+        out.append(c * t * abs(t) if virgin else th_r + c * (t - t_r) * abs(t - t_r) / 2)
+    return np.array(out)

@@ -49,6 +49,8 @@ from hdwf.validation.synthesis import synth_designs, synthesize
 from hdwf.validation.variants import (SolveSetup, candidate_names, mean_lost_motion, plan_variants, specimen_solver,
                                       variant_key)
 
+from conftest import masing_loop
+
 UNIT = "hd42"
 N_SPECIMENS = 12
 SEED = 11
@@ -290,22 +292,6 @@ def test_plan_before_measuring_predicts_what_the_diagnosis_reports(tmp_path, spe
                    "tooth_friction": False}
 
 
-def _masing(T: np.ndarray, loop: float) -> np.ndarray:
-    """A Masing loop along the test, written out branch by branch (independent of the effect's
-    code in hdwf.fe.cycle): virgin curve c T|T|, after a reversal at (T_r, θ_r)
-    θ_r + c (T - T_r)|T - T_r| / 2, c = loop / T_max², so the branches are ``loop`` apart at
-    zero torque."""
-    c = loop / np.max(np.abs(T)) ** 2
-    out, t_r, th_r, virgin, d_prev = [], 0.0, 0.0, True, 0.0
-    for k, t in enumerate(T):
-        if k:
-            d = np.sign(t - T[k - 1])
-            if d_prev and d and d != d_prev:
-                t_r, th_r, virgin = T[k - 1], out[-1], False
-            d_prev = d or d_prev
-        out.append(c * t * abs(t) if virgin else th_r + c * (t - t_r) * abs(t - t_r) / 2)
-    return np.array(out)
-
 
 def _measured_with_loop(tmp_path, specimens, tables, loop, noise):
     """Bench data: the campaign model's own curves, a Masing hysteresis loop ``loop`` arcmin wide
@@ -316,7 +302,7 @@ def _measured_with_loop(tmp_path, specimens, tables, loop, noise):
     for spec in specimens.to_dict(orient="records"):
         g = base[base["specimen_id"] == spec["specimen_id"]].sort_values("step")
         T = g["torque_Nm"].to_numpy()
-        twist = g["twist_arcmin"].to_numpy() + _masing(T, loop) + rng.normal(0.0, noise, len(T))
+        twist = g["twist_arcmin"].to_numpy() + masing_loop(T, loop) + rng.normal(0.0, noise, len(T))
         rows += [{**spec, "step": int(k), "torque_Nm": t, "twist_arcmin": w, "u_twist_arcmin": noise}
                  for k, t, w in zip(g["step"], T, twist)]
     path = tmp_path / "loop.csv"

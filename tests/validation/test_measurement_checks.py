@@ -10,7 +10,7 @@ from hdwf.study.paper import paper_measurements
 from hdwf.validation.measurements import (READING_LIMIT_ARCMIN, MeasurementError, load_measurements,
                                          schedule_problems)
 
-from conftest import DATA, ROOT
+from conftest import DATA, ROOT, write_table
 
 SHIPPED = ROOT / "data" / "validation"
 PARAMS = {"d_mm": 31.008, "D_mm": 41.992, "Gr_mm": 0.012, "rFS_mm": 0.01, "rCS_mm": 0.01}
@@ -40,14 +40,6 @@ def _lost_motion() -> pd.DataFrame:
 FORMS = {"curve": _curve, "phi": _phi, "lost_motion": _lost_motion}
 
 
-def _write(df: pd.DataFrame, tmp_path, name: str = "m.csv"):
-    path = tmp_path / name
-    if name.endswith(".csv"):
-        df.to_csv(path, index=False)
-    else:
-        df.to_parquet(path, index=False)
-    return path
-
 
 def _refused(path, **kw) -> list[str]:
     with pytest.raises(MeasurementError) as exc:
@@ -67,7 +59,7 @@ def test_the_shipped_files_still_load():
 
 @pytest.mark.parametrize("unit", ["hd42", "hd120"])
 def test_the_papers_tables_load(tmp_path, unit):
-    path = _write(paper_measurements(DATA, unit), tmp_path, f"paper_{unit}.csv")
+    path = write_table(paper_measurements(DATA, unit), tmp_path, f"paper_{unit}.csv")
     m = load_measurements(path, unit=unit)
     assert m.form == "lost_motion" and len(m.specimens) == 27
 
@@ -97,7 +89,7 @@ BAD_VALUES = [
 def test_an_implausible_value_is_refused_with_row_field_and_value(tmp_path, name, form, row, column, value, says):
     df = FORMS[form]()
     df.loc[row - 1, column] = value
-    lines = _refused(_write(df, tmp_path, name))
+    lines = _refused(write_table(df, tmp_path, name))
     assert len(lines) == 1, lines
     assert lines[0].startswith(f"{tmp_path / name}, row {row}, field '{column}', value {value!r}: "), lines
     assert says in lines[0]
@@ -110,7 +102,7 @@ def test_an_implausible_value_is_refused_with_row_field_and_value(tmp_path, name
 def test_values_at_the_bounds_load(tmp_path, form, column, value):
     df = FORMS[form]()
     df.loc[0, column] = value
-    assert len(load_measurements(_write(df, tmp_path)).specimens) == 2
+    assert len(load_measurements(write_table(df, tmp_path)).specimens) == 2
 
 
 def _holding(content: bytes):
@@ -149,7 +141,7 @@ def test_a_flipped_torque_sign_is_refused_per_specimen(tmp_path):
     """Case 5: S2's torque column has the wrong sign; S1 is fine."""
     df = _curve()
     df.loc[9:, "torque_Nm"] *= -1
-    lines = _refused(_write(df, tmp_path))
+    lines = _refused(write_table(df, tmp_path))
     assert len(lines) == 1, lines
     assert lines[0].startswith(f"{tmp_path / 'm.csv'}, row 10, field 'torque_Nm': specimen 'S2': "
                                "twist falls as torque rises (least-squares slope -"), lines
@@ -161,8 +153,8 @@ def test_the_sign_test_is_about_the_relation_not_the_signs(tmp_path):
     one flipped is refused on every specimen."""
     demo = pd.read_csv(SHIPPED / "demo_hd42.csv")
     both = demo.assign(torque_Nm=-demo["torque_Nm"], twist_arcmin=-demo["twist_arcmin"])
-    assert len(load_measurements(_write(both, tmp_path, "both.csv")).specimens) == 16
-    lines = _refused(_write(demo.assign(twist_arcmin=-demo["twist_arcmin"]), tmp_path, "twist.csv"))
+    assert len(load_measurements(write_table(both, tmp_path, "both.csv")).specimens) == 16
+    lines = _refused(write_table(demo.assign(twist_arcmin=-demo["twist_arcmin"]), tmp_path, "twist.csv"))
     assert len(lines) == 16 and all("field 'torque_Nm'" in s and "a sign is flipped" in s for s in lines)
 
 
@@ -171,13 +163,13 @@ def test_a_curve_lost_in_its_noise_is_not_called_flipped(tmp_path):
     df = _curve(("S1",))
     df["twist_arcmin"] = 0.001 * np.sign(df["torque_Nm"]) + np.random.default_rng(1).normal(0, 0.02, len(df))
     df["twist_arcmin"] -= 0.004 * df["torque_Nm"]  # a slight downward tilt, well inside the noise
-    assert len(load_measurements(_write(df, tmp_path)).specimens) == 1
+    assert len(load_measurements(write_table(df, tmp_path)).specimens) == 1
 
 
 def test_a_campaign_for_one_drive_refuses_other_drives_and_bad_ids(tmp_path):
     df = _curve()
     df.loc[9:, "specimen_id"] = "S 2"
-    path = _write(df, tmp_path)
+    path = write_table(df, tmp_path)
     lines = _refused(path, unit="hd120")
     assert f"{path}, row 1, field 'unit', value 'hd42': specimen 'S1' is not of hd120" in lines[0]
     assert any(s.startswith(f"{path}, row 10, field 'specimen_id', value 'S 2': specimen ids may use") for s in lines)

@@ -9,7 +9,7 @@ import pytest
 from hdwf.study.paper import table3_bounds
 from hdwf.validation.measurements import TABLE3_BOUNDS, MeasurementError, load_measurements
 
-from conftest import DATA
+from conftest import DATA, write_table
 
 PARAMS = {"d_mm": 31.008, "D_mm": 41.992, "Gr_mm": 0.012, "rFS_mm": 0.01, "rCS_mm": 0.01}
 TORQUES = [0.0, 0.48, 0.96, 0.48, 0.0, -0.48, -0.96, -0.48, 0.0]
@@ -24,28 +24,20 @@ def _curve(specimens=("S1", "S2")):
     return pd.DataFrame(rows)
 
 
-def _write(df, tmp_path, name="m.csv"):
-    path = tmp_path / name
-    if name.endswith(".csv"):
-        df.to_csv(path, index=False)
-    else:
-        df.to_parquet(path, index=False)
-    return path
-
 
 @pytest.mark.parametrize("name", ["m.csv", "m.parquet"])
 def test_curve_form_loads(tmp_path, name):
-    m = load_measurements(_write(_curve(), tmp_path, name))
+    m = load_measurements(write_table(_curve(), tmp_path, name))
     assert m.form == "curve" and len(m.specimens) == 2 and m.units == ["hd42"]
 
 
 def test_phi_and_lost_motion_forms(tmp_path):
     df = pd.DataFrame([{"specimen_id": "A", "unit": "HD42", **PARAMS, "phi_plus_arcmin": 0.2, "phi_minus_arcmin": 0.25}])
-    m = load_measurements(_write(df, tmp_path))
+    m = load_measurements(write_table(df, tmp_path))
     assert m.form == "phi" and m.specimens.loc[0, "lost_motion_arcmin"] == pytest.approx(0.45)
     df = pd.DataFrame([{"specimen_id": "A", "unit": "hd120", "d_mm": 90.01, "D_mm": 119.99, "Gr_mm": 0.02,
                         "rFS_mm": 0.04, "rCS_mm": 0.04, "lost_motion_arcmin": 1.2}])
-    assert load_measurements(_write(df, tmp_path)).form == "lost_motion"
+    assert load_measurements(write_table(df, tmp_path)).form == "lost_motion"
 
 
 def _problems(path):
@@ -60,7 +52,7 @@ def test_every_problem_is_reported_and_the_file_is_untouched(tmp_path):
     df.loc[5, "step"] = 4                        # row 6: duplicate step of S1
     df.loc[11, "unit"] = "hd50"                  # row 12: unknown drive
     df.loc[13, "rFS_mm"] = 0.5                   # row 14: outside the model
-    path = _write(df, tmp_path)
+    path = write_table(df, tmp_path)
     before = hashlib.sha256(path.read_bytes()).hexdigest()
     err, msg = _problems(path)
     assert "m.csv, row 4, field 'twist_arcmin'" in msg
@@ -72,7 +64,7 @@ def test_every_problem_is_reported_and_the_file_is_untouched(tmp_path):
 
 def test_missing_column_and_wrong_unit(tmp_path):
     df = _curve().rename(columns={"twist_arcmin": "twist_deg"}).drop(columns="Gr_mm")
-    _, msg = _problems(_write(df, tmp_path))
+    _, msg = _problems(write_table(df, tmp_path))
     assert "field 'twist_deg'" in msg and "wrong unit" in msg and "twist_arcmin" in msg
     assert "field 'Gr_mm'" in msg and "missing column" in msg
 
@@ -80,14 +72,14 @@ def test_missing_column_and_wrong_unit(tmp_path):
 def test_torque_in_wrong_unit_is_caught_by_size(tmp_path):
     df = _curve()
     df["torque_Nm"] *= 1000  # N·mm given as N·m
-    _, msg = _problems(_write(df, tmp_path))
+    _, msg = _problems(write_table(df, tmp_path))
     assert "row 3, field 'torque_Nm', value 960.0" in msg and "1.5 × the test torque" in msg
 
 
 def test_inconsistent_specimen_parameters(tmp_path):
     df = _curve()
     df.loc[2, "d_mm"] = 31.01
-    _, msg = _problems(_write(df, tmp_path))
+    _, msg = _problems(write_table(df, tmp_path))
     assert "row 3, field 'd_mm'" in msg and "changes d_mm" in msg
 
 

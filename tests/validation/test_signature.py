@@ -18,6 +18,8 @@ from hdwf.validation.measurements import Measurements
 from hdwf.validation.signature import SIGNIFICANT_Z, residual_signature
 from hdwf.validation.variants import plan_variants, variant_key
 
+from conftest import masing_loop
+
 T_TEST = 0.96          # N·m, 4 % of T_N of the HD 42
 
 
@@ -226,27 +228,12 @@ def test_report_shows_the_signature():
     assert empty.blocks == []
 
 
-def _masing(T: np.ndarray, loop: float) -> np.ndarray:
-    """A Masing loop along the test, written out branch by branch (independent of hdwf.fe.cycle):
-    virgin curve c T|T|, after a reversal at (T_r, θ_r) θ_r + c (T - T_r)|T - T_r| / 2, with
-    c = loop / T_max², so the branches are ``loop`` apart at zero torque."""
-    c = loop / np.max(np.abs(T)) ** 2
-    out, t_r, th_r, virgin, d_prev = [], 0.0, 0.0, True, 0.0
-    for k, t in enumerate(T):
-        if k:
-            d = np.sign(t - T[k - 1])
-            if d_prev and d and d != d_prev:
-                t_r, th_r, virgin = T[k - 1], out[-1], False
-            d_prev = d or d_prev
-        out.append(c * t * abs(t) if virgin else th_r + c * (t - t_r) * abs(t - t_r) / 2)
-    return np.array(out)
-
 
 def test_a_masing_loop_is_named_a_hysteresis_loop_not_play():
     """A loop 0.2 arcmin wide at zero torque: the zero-torque gap is its width, and because the
     branches stay apart under load (a dead band would close) the text calls it a hysteresis loop."""
     T = _torques(5)
-    loop = dict(zip(zip(np.round(T, 9), branches(T)), _masing(T, 0.2)))
+    loop = dict(zip(zip(np.round(T, 9), branches(T)), masing_loop(T, 0.2)))
     sig = residual_signature(_curves(lambda t, side, b, p: loop[(round(t, 9), b)], noise=0.008, u=0.008), "curve")
     assert sig.term("dead_band").value == pytest.approx(0.2, rel=0.05)
     assert sig.term("loop_width").significant and sig.term("loop_width").value > 0
