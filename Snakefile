@@ -10,6 +10,7 @@ from pathlib import Path
 from snakemake.utils import min_version
 
 from hdwf.config import SCHEMA_PATH, validate_config
+from hdwf.validation.measurements import SPECIMEN_ID_PATTERN
 
 min_version("9.0")
 
@@ -30,7 +31,7 @@ wildcard_constraints:
     design=r"[A-Za-z0-9_\-]+",
     ref=r"[0-9.]+",
     campaign=_alternatives(list(CAMPAIGNS)),
-    specimen=r"[A-Za-z0-9_.\-]+",
+    specimen=SPECIMEN_ID_PATTERN,   # the ids the measurement loader accepts
 
 include: "workflow/rules/doe.smk"
 include: "workflow/rules/paper.smk"

@@ -24,6 +24,12 @@ from hdwf.validation.synthesis import design_ranges, format_ranges, parse_range,
 from hdwf.validation.variants import SolveSetup
 
 
+def _print_problems(exc: MeasurementError, prefix: str = "") -> None:
+    """Every problem of a measurement file on a line of its own (the exception's text stops at 25)."""
+    for line in exc.lines:
+        print(f"hdwf: error: {prefix}{line}", file=sys.stderr)
+
+
 def _check_config(args) -> int:
     config = load_config(args.config, args.schema)
     print(f"{args.config}: valid; config hash {config_hash(config)}")
@@ -36,8 +42,7 @@ def _check_config(args) -> int:
             specimens = campaign_specimens(dataclasses.replace(plan, measurements=str(root / plan.measurements)))
         except MeasurementError as exc:
             failed = True
-            for line in exc.lines:
-                print(f"hdwf: error: campaign '{name}': {line}", file=sys.stderr)
+            _print_problems(exc, f"campaign '{name}': ")
             continue
         print(f"campaign '{name}': {plan.measurements}: {len(specimens)} specimens of {plan.unit}: ok")
     return 1 if failed else 0
@@ -178,8 +183,7 @@ def _check_measurements(args) -> int:
     try:
         m = load_measurements(args.file, unit=args.unit)
     except MeasurementError as exc:
-        for line in exc.lines:
-            print(f"hdwf: error: {line}", file=sys.stderr)
+        _print_problems(exc)
         return 1
     print(f"{args.file}: {len(m.specimens)} specimens, {len(m.data)} points, form {m.form}: ok")
     return 0

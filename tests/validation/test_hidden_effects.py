@@ -338,4 +338,3 @@ def test_a_loop_no_candidate_offers_is_described_by_its_signature(tmp_path, spec
     gap = next(t for t in sig["terms"] if t["name"] == "dead_band")
     assert gap["value_arcmin"] == pytest.approx(0.2, rel=0.2)
     assert "a hysteresis loop" in sig["text"], sig["text"]
-    assert diag["verdict"]["missing_effect"] != "microslip_hysteresis"

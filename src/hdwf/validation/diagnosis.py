@@ -303,15 +303,15 @@ def _noise(obs: pd.DataFrame, g: _GreedySearch) -> tuple[float | None, float, st
     return None, sigma, "the residual of the final model (no noise stated: an upper bound on the noise)"
 
 
-def _signature(form: str, base_points: pd.DataFrame, g: _GreedySearch) -> ResidualSignature:
+def _signature(form: str, base_points: pd.DataFrame, g: _GreedySearch, final_rmse_arcmin: float) -> ResidualSignature:
     """The signature of the campaign model's residual, its text naming what the search found (or
     the closest candidate of round 1 when it found nothing)."""
     found = [e for e in g.on if e not in g.search.calibrate_first]
     first = g.rounds[0]
     closest = first.verdict.ranking[0] if first.verdict.ranking and not found else None
     at_bound = closest is not None and first.evidence[closest.effect].at_bound
-    return with_verdict(residual_signature(base_points, form), found, float(np.sqrt(g.fit.rss / len(g.data.D))),
-                        closest, at_bound, first.current_rmse_arcmin)
+    return with_verdict(residual_signature(base_points, form), found, final_rmse_arcmin, closest, at_bound,
+                        first.current_rmse_arcmin)
 
 
 def _diagnosis(meas: Measurements, obs: pd.DataFrame, g: _GreedySearch, table_resp: dict[str, Response],
@@ -329,14 +329,15 @@ def _diagnosis(meas: Measurements, obs: pd.DataFrame, g: _GreedySearch, table_re
     units = meas.units
     pay = g.search.pay_threshold
     seen = detectability(table_resp, sigma, n, units[0] if len(units) == 1 else None, pay)
+    final_rmse = float(np.sqrt(fit.rss / n))
     return Diagnosis(
         form=meas.form, n_points=int(n), n_specimens=int(len(pd.unique(g.specimen))), noise_arcmin=noise,
         fixed=dict(g.search.fixed), calibrated_first=list(g.search.calibrate_first), baseline=summary,
         rounds=g.rounds, found=found, final_effects=fit.params(resp),
-        final_rmse_arcmin=float(np.sqrt(fit.rss / n)),
+        final_rmse_arcmin=final_rmse,
         detectability=DataDetectability(sigma, sigma_from, pay, seen), notes=notes, refinement=g.refinement,
         per_specimen=per, residual_tests=tests, points=_points(meas, obs, g.data.S0, fit.S, base_points),
-        signature=_signature(meas.form, base_points, g))
+        signature=_signature(meas.form, base_points, g, final_rmse))
 
 
 def diagnose(meas: Measurements, table: pd.DataFrame, search: Search | None = None,

@@ -436,18 +436,21 @@ def schedule_problems(meas: Measurements, steps_per_ramp: int) -> list[tuple]:
     if meas.form != "curve":
         return []
     fractions = torque_fractions(steps_per_ramp)
+    d = meas.data
+    step, torque = d["step"].to_numpy(int), d["torque_Nm"].to_numpy(float)
+    test = np.array([lost_motion_test_torque_Nm(u) for u in d["unit"]])
+    inside = (step >= 0) & (step < len(fractions))
+    model = np.where(inside, fractions[np.clip(step, 0, len(fractions) - 1)], np.nan) * test
+    off = inside & (np.abs(torque - model) > 0.25 * test / steps_per_ramp)
     problems = []
-    for i, row in meas.data.iterrows():
-        step, torque, test = int(row["step"]), float(row["torque_Nm"]), lost_motion_test_torque_Nm(row["unit"])
-        if not 0 <= step < len(fractions):
-            problems.append((i + 1, "step", step, f"not a step of the campaign's test (steps 0-{len(fractions) - 1} at "
-                                                  f"steps_per_ramp {steps_per_ramp}); set the campaign's steps_per_ramp "
-                                                  "to match the data"))
-            continue
-        model = fractions[step] * test
-        if abs(torque - model) > 0.25 * test / steps_per_ramp:
-            problems.append((i + 1, "torque_Nm", torque,
+    for i in np.flatnonzero(~inside | off):
+        if not inside[i]:
+            problems.append((i + 1, "step", int(step[i]), f"not a step of the campaign's test (steps 0-{len(fractions) - 1} "
+                                                          f"at steps_per_ramp {steps_per_ramp}); set the campaign's "
+                                                          "steps_per_ramp to match the data"))
+        else:
+            problems.append((i + 1, "torque_Nm", float(torque[i]),
                              f"the campaign's test (0 → +T → 0 → −T → 0, steps_per_ramp {steps_per_ramp}) is at "
-                             f"{model:+.4g} N·m at step {step}: another number of steps per ramp, or a test run −T "
-                             "first? set the campaign's steps_per_ramp, or number the steps in the model's order"))
+                             f"{model[i]:+.4g} N·m at step {int(step[i])}: another number of steps per ramp, or a test "
+                             "run −T first? set the campaign's steps_per_ramp, or number the steps in the model's order"))
     return problems

@@ -421,7 +421,7 @@ def residual_signature(points: pd.DataFrame, form: str) -> ResidualSignature:
 def _dominant_phrase(sig: ResidualSignature, dom: SignatureTerm) -> str:
     """The dominant term in words. A wider gap at zero torque whose branches stay apart under load
     too is a hysteresis loop, not play: a dead band closes as soon as the torque is non-zero."""
-    loop = next((t for t in sig.terms if t.name == "loop_width"), None)
+    loop = sig.term("loop_width")
     if dom.name == "dead_band" and dom.value > 0 and loop is not None and loop.significant and loop.value > 0:
         return (f"a hysteresis loop {_phrase(dom, bare=True)} arcmin wide at zero torque whose branches stay "
                 f"{_phrase(loop, bare=True)} arcmin apart under load (play would close under load)")
