@@ -40,7 +40,7 @@ from hdwf.validation.detectability import Visibility, detectability
 from hdwf.validation.effects import get as get_effect
 from hdwf.validation.measurements import Measurements
 from hdwf.validation.observations import observation_frame, predict, prediction_points
-from hdwf.validation.signature import ResidualSignature, residual_signature, with_verdict
+from hdwf.validation.signature import NoiseCheck, ResidualSignature, residual_signature, with_verdict
 from hdwf.validation.variants import candidate_names, variant_key
 
 
@@ -293,10 +293,15 @@ def _points(meas: Measurements, obs: pd.DataFrame, S_model: np.ndarray, S_final:
     return points
 
 
-def _noise(obs: pd.DataFrame, g: _GreedySearch) -> tuple[float | None, float, str]:
-    """The noise the file states (RMS, None when none), and the noise the detectability is judged by."""
+def _noise(obs: pd.DataFrame, g: _GreedySearch, check: NoiseCheck) -> tuple[float | None, float, str]:
+    """The noise the file states (RMS, None when none), and the noise the detectability is judged by:
+    the stated one, unless the signature's check found it far below the data's scatter (then that
+    estimate), or the final model's residual when none is stated."""
     u = obs["u_D"].to_numpy(float)
     noise = float(np.sqrt(np.nanmean(u ** 2))) if np.isfinite(obs["u_D"]).any() else None
+    if noise is not None and check.flag and check.estimate_arcmin:
+        return noise, check.estimate_arcmin, (f"the scatter estimated from the data ({check.estimate_from}): the "
+                                              f"stated uncertainty, {noise:.3g} arcmin RMS, is far below it")
     if noise is not None:
         return noise, noise, "the noise stated in the measurement file"
     sigma = float(np.sqrt(g.fit.rss / max(len(g.data.D) - len(g.on), 1)))
@@ -325,11 +330,12 @@ def _diagnosis(meas: Measurements, obs: pd.DataFrame, g: _GreedySearch, table_re
     tests = residual_tests(base_points)
     resp, fit, n = g.data.resp, g.fit, len(g.data.D)
     found = [Found(e, fit.params(resp)[e], fit.param_sd(resp)[e]) for e in g.on]
-    noise, sigma, sigma_from = _noise(obs, g)
+    final_rmse = float(np.sqrt(fit.rss / n))
+    signature = _signature(meas.form, base_points, g, final_rmse)
+    noise, sigma, sigma_from = _noise(obs, g, signature.noise)
     units = meas.units
     pay = g.search.pay_threshold
     seen = detectability(table_resp, sigma, n, units[0] if len(units) == 1 else None, pay)
-    final_rmse = float(np.sqrt(fit.rss / n))
     return Diagnosis(
         form=meas.form, n_points=int(n), n_specimens=int(len(pd.unique(g.specimen))), noise_arcmin=noise,
         fixed=dict(g.search.fixed), calibrated_first=list(g.search.calibrate_first), baseline=summary,
@@ -337,7 +343,7 @@ def _diagnosis(meas: Measurements, obs: pd.DataFrame, g: _GreedySearch, table_re
         final_rmse_arcmin=final_rmse,
         detectability=DataDetectability(sigma, sigma_from, pay, seen), notes=notes, refinement=g.refinement,
         per_specimen=per, residual_tests=tests, points=_points(meas, obs, g.data.S0, fit.S, base_points),
-        signature=_signature(meas.form, base_points, g, final_rmse))
+        signature=signature)
 
 
 def diagnose(meas: Measurements, table: pd.DataFrame, search: Search | None = None,

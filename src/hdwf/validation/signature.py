@@ -357,7 +357,7 @@ def noise_check(stated: np.ndarray, estimate: float | None, estimate_from: str, 
     Returns
     -------
     NoiseCheck
-        With the note the report prints (the diagnosis's numbers are not switched to the estimate).
+        With the note the report prints (when flagged, the diagnosis judges detectability by the estimate).
     """
     u = np.asarray(stated, float)
     med = float(np.median(u[np.isfinite(u)])) if np.isfinite(u).any() else None
@@ -370,9 +370,9 @@ def noise_check(stated: np.ndarray, estimate: float | None, estimate_from: str, 
     if med * NOISE_FLAG_RATIO >= estimate:
         return NoiseCheck(med, estimate, estimate_from, n_used, False, "")
     note = (f"stated uncertainty {med:.3f} arcmin is far below the scatter {estimate:.3g} arcmin estimated from "
-            "the data; the estimate is used to read this signature. The verdict (ΔBIC, leave-one-out error) does "
-            "not use the stated uncertainty; the detectability table and u_val do and were not switched: they "
-            "overstate what this data can show")
+            "the data; the estimate is used to read this signature and to judge what the data can show (the "
+            "detectability table). The verdict (ΔBIC, leave-one-out error) does not use the stated uncertainty; "
+            "u_val does, so it understates the comparison's uncertainty")
     return NoiseCheck(med, estimate, estimate_from, n_used, True, note)
 
 
