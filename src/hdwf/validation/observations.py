@@ -134,14 +134,8 @@ def branch_twist(model_torque: np.ndarray, model_twist: np.ndarray, torque: np.n
     Both tests are split into branches by ``comparison.branches`` (load± while |T| rises,
     unload± while it falls); a measured point takes the model's twist interpolated linearly in
     |T| on the model's branch of the same kind (from the point that starts it), so measured
-    torques on the model's steps get the model's values exactly.
-
-    Parameters
-    ----------
-    model_torque, model_twist : numpy.ndarray
-        The model's test 0 → +T → 0 → −T → 0, in its order.
-    torque : numpy.ndarray
-        One specimen's measured torques, in test order.
+    torques on the model's steps get the model's values exactly. Parameters as
+    ``twist_along_test``.
 
     Returns
     -------
