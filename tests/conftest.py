@@ -13,11 +13,24 @@ def paper_dir():
     return DATA
 
 
+# The test files that take minutes, longest first (`pytest -n 2 --durations=0`, summed per
+# file). `pytest -n 2` hands each file to one worker whole (pyproject.toml): starting the long
+# ones first lets both workers finish together instead of one running a late long file alone.
+LONGEST_FIRST = [
+    "validation/test_hidden_effects_dense.py",
+    "validation/test_hidden_effects.py",
+    "workflow/test_workflow_e2e.py",
+    "workflow/test_slurm.py",
+]
+
+
 def pytest_collection_modifyitems(items):
     # every end-to-end run of a Snakemake target is slow; `pytest -m "not slow"` leaves them out
     for item in items:
         if item.get_closest_marker("e2e"):
             item.add_marker(pytest.mark.slow)
+    rank = {name: i for i, name in enumerate(LONGEST_FIRST)}
+    items.sort(key=lambda item: rank.get(item.path.relative_to(ROOT / "tests").as_posix(), len(rank)))
 
 
 def write_table(df: pd.DataFrame, tmp_path, name: str = "m.csv") -> Path:

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import ROOT
+from conftest import LONGEST_FIRST, ROOT
 
 SRC = ROOT / "src" / "hdwf"
 MODULES = sorted(SRC.rglob("*.py"))
@@ -49,6 +49,11 @@ def _layer(module: str) -> int | None:
 
 def test_the_source_tree_is_found():
     assert len(MODULES) > 30, MODULES
+
+
+def test_the_long_test_files_started_first_exist():
+    # a renamed file would silently lose its early start under `pytest -n 2`
+    assert [f for f in LONGEST_FIRST if not (ROOT / "tests" / f).is_file()] == []
 
 
 @pytest.mark.parametrize("path", MODULES, ids=lambda p: str(p.relative_to(SRC)))

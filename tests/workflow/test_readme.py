@@ -17,7 +17,7 @@ def test_ci_runs_the_readme_test_command():
     assert len(commands) == 2  # exactly two: install and run the main job; install and run the tests
     main_job, tests = commands
     assert main_job.endswith(".venv/bin/snakemake --cores 2")
-    assert tests.endswith(".venv/bin/python -m pytest -q")
+    assert tests.endswith(".venv/bin/python -m pytest -q -n 2")
     assert tests in (ROOT / ".ci" / "run").read_text()
 
 
