@@ -1,7 +1,7 @@
 """Which noise does each candidate effect need to be found? Measured against predicted.
 
 For every candidate effect at its realistic value (and for no effect), the FE model makes
-the curves of N HD 42 specimens once (coarse test mesh, as in tests/validation/test_hidden_effects.py);
+the curves of N HD 42 specimens once (coarse test mesh, as in tests/validation/hidden_setup.py);
 Gaussian noise of several levels, with several seeds, is added; each data set is diagnosed
 (one round). A row counts how often the effect was named (first, or among the
 indistinguishable), how often its parameter came back within 15 %, and whether the
