@@ -5,7 +5,8 @@ to the noise — and must not invent an effect when there is none.
 Coarse mesh (5 elements over the tooth height, 3 over its thickness, half model), 12 HD 42
 specimens. The model tables (campaign model + every candidate's grid) depend on the specimens
 only, so they are solved once for the module per set of specimens (the paper's design space
-at 21 points per curve, the catalogue-grade batch at 401) and shared by the tests on that set.
+at 21 points per curve, the catalogue-grade batch at 201) and shared by the tests on that set.
+Variants that differ only in series elements share one solve (``solve_lost_motion_variants``).
 
 Noise levels. Our 2D model's lost motion over the paper's design space is dominated by its
 dead band (about 9 arcmin on this mesh, docs/fe-model.md), so noise of 2 % of the lost
@@ -22,17 +23,18 @@ over all points (hdwf.validation.detectability).
   under 42 mm), the smallest radial clearance of Table 3 (5 to 8 µm) and tooth offsets within
   2 µm of the zero-backlash design. Its lost motion is about 1.15 arcmin on average (0.46 to
   1.94 over the specimens): a catalogue unit's 1 arcmin, inside the paper's HD 42 range (0.18
-  to 1.49). Curves of 401 points (100 steps per
+  to 1.49). Curves of 201 points (50 steps per
   ramp, a bench logging continuously); 2 % noise is 0.023 arcmin (1.4 arcsec) per reading.
   Cup torsion and housing compliance are found and recovered within 15 %, and so is flank
-  friction at mu 0.1 (expected sd 7 %). Two hidden effects (temperature, cup) are found in
+  friction at mu 0.1 (expected sd 10 %). Two hidden effects (temperature, cup) are found in
   two rounds, with the first recalibrated on actual solves before the second round
-  (``diagnose(..., solve=...)``, as the workflow does).
+  (``diagnose(..., solve=...)``, as the workflow does), at 1.4 % noise: the information per
+  curve of 2 % at 401 points, where the two compliances part by more than the tie threshold.
 * Flank friction changes the curves by about 0.003 arcmin RMS on either batch: our section's
   flanks barely slide (docs/validation.md). It shows only where the noise is small in
-  absolute terms, so only on the tight batch. At mu 0.08 its expected sd there is 10 %, and
-  noise seed 11 misses 15 % (0.0923, 15.4 % off; 4 of 5 seeds pass). The test therefore uses
-  mu 0.1, the upper end of the lubricated-steel range 0.05 to 0.1. At 0.2 % noise on the
+  absolute terms, so only on the tight batch. At mu 0.08 its expected sd there is 14 % (at
+  401 points 10 %, where noise seed 11 missed 15 %: 0.0923). The test therefore uses mu 0.1,
+  the upper end of the lubricated-steel range 0.05 to 0.1. At 0.2 % noise on the
   design-space curves, the diagnosis must report it as unseen or found, never both.
 """
 
@@ -44,6 +46,7 @@ import pytest
 
 from hdwf.validation.detectability import detectability_of_tables
 from hdwf.validation.diagnosis import Search, diagnose
+from hdwf.validation.effects import get as get_effect
 from hdwf.validation.measurements import load_measurements
 from hdwf.validation.synthesis import synth_designs, synthesize
 from hdwf.validation.variants import (SolveSetup, candidate_names, mean_lost_motion, plan_variants, specimen_solver,
@@ -57,7 +60,7 @@ SEED = 11
 SETTINGS = dict(elements_over_height=5, elements_over_thickness=3, refinement=1.0, symmetry="half")
 JOBS = 2
 STEPS = 5           # per ramp: 21 points per curve
-DENSE_STEPS = 100   # 401 points per curve
+DENSE_STEPS = 50    # 201 points per curve
 # a catalogue-grade batch: tight bearing fits, Table 3's smallest radial clearance, dimension
 # over / between pins within 2 µm of the zero-backlash design (lost motion about 1.15 arcmin)
 BATCH = {"d_mm": (31.0, 31.004), "D_mm": (41.996, 42.0), "Gr_mm": (0.005, 0.008),
@@ -146,7 +149,11 @@ def _check_found(diag, effect, param, true, meas, specimens, noise, steps=STEPS)
     entry = next(r for r in diag["ranking"] if r["effect"] == effect)
     est = entry["params"][param]
     assert est == pytest.approx(true, rel=0.15), (effect, est, true)
-    rmse = _rmse_switched_on(meas, specimens, {effect: {param: est}}, steps)
+    if get_effect(effect).series:    # exact in the tables (tests/validation/test_effects.py)
+        assert diag["final"]["effects"] == {effect: {param: est}}
+        rmse = diag["final"]["rmse_arcmin"]
+    else:                            # switched on: actual solves, not the tables' splines
+        rmse = _rmse_switched_on(meas, specimens, {effect: {param: est}}, steps)
     assert rmse <= 1.3 * noise, (effect, rmse, noise)
 
 
@@ -168,15 +175,14 @@ def test_dead_band_effect_found_at_two_percent_noise(tmp_path, specimens, tables
 @pytest.mark.parametrize("effect", ["fs_cup_torsion", "cs_housing", "tooth_friction"])
 def test_elastic_effect_found_at_two_percent_noise_on_a_dense_catalogue_grade_batch(
         tmp_path, batch_specimens, dense_tables, batch_signal, effect):
-    """A batch of catalogue-grade drives (lost motion about 1.15 arcmin) logged at 401 points
+    """A batch of catalogue-grade drives (lost motion about 1.15 arcmin) logged at 201 points
     per curve: 2 % of its lost motion is 0.023 arcmin (1.4 arcsec) per reading. Cup torsion
-    (expected sd of K 1 %), housing compliance (3 %) and flank friction at mu 0.1 (7 %) are
+    (expected sd of K 1.4 %), housing compliance (4 %) and flank friction at mu 0.1 (10 %) are
     each named first, with no look-alike, and recovered within 15 %."""
     diag = _hidden_one(tmp_path, batch_specimens, dense_tables, effect, 0.02 * batch_signal, DENSE_STEPS, BATCH,
                        BATCH_VALUES)
     # stricter than the issue's "first or among the indistinguishable": on this batch each
-    # stands clear of the runner-up (ΔBIC gaps in seed 11: cup torsion 20 over housing compliance,
-    # housing 993, friction 165; the tie threshold is 6)
+    # stands clear of the runner-up by more than the tie threshold (ΔBIC 6)
     assert diag["verdict"]["missing_effect"] == effect and diag["verdict"]["indistinguishable_from"] == []
 
 
@@ -202,15 +208,16 @@ def test_elastic_effects_are_not_claimed_below_the_noise(tmp_path, specimens, ta
 
 
 def test_two_hidden_effects_found_in_two_rounds(tmp_path, batch_specimens, dense_tables, batch_signal):
-    """A temperature difference (12 K) and cup torsion, noise of 2 % of the signal on the
-    dense catalogue-grade batch. Round 1 finds the temperature; before round 2 it is
-    recalibrated on actual solves near its estimate, because near zero clearance the teeth
-    close one by one between the 10 K values of its grid and the table's spline is off there.
-    On the tables alone round 2 cannot tell cup torsion from housing compliance, which absorbs
-    that spline error (ΔBIC -3863.8 against -3860.1, seed 11); with the re-solves cup torsion
-    wins outright (-4263.6 against -4245.1) and both values come back within 1 %."""
+    """A temperature difference (12 K) and cup torsion, noise of 1.4 % of the signal (the
+    information per curve of 2 % at 401 points) on the dense catalogue-grade batch. Round 1
+    finds the temperature; before round 2 it is recalibrated on actual solves near its
+    estimate, because near zero clearance the teeth close one by one between the 10 K values
+    of its grid and the table's spline is off there. On the tables alone round 2 cannot tell
+    cup torsion from housing compliance, which absorbs that spline error (their ΔBIC within
+    the tie threshold, seed 11); with the re-solves cup torsion wins outright and both values
+    come back within 15 %."""
     hidden = {"thermal": {"delta_T_K": 12.0}, "fs_cup_torsion": {"K_Nm_per_rad": 6.0e4}}
-    noise = 0.02 * batch_signal
+    noise = 0.014 * batch_signal
     meas = _measure(tmp_path, batch_specimens, hidden, noise, DENSE_STEPS, BATCH)
 
     # the control: on the tables' splines alone, round 2 is a tie between the two compliances
@@ -318,23 +325,33 @@ LOOP_NOISE = 0.008   # arcmin per reading (0.5 arcsec)
 def test_a_catalogue_size_hysteresis_loop_is_found(tmp_path, specimens, tables, loop):
     """A hysteresis loop of catalogue size made by a Masing law written out here, at 0.008 arcmin
     noise: micro-slip hysteresis is named, its loop width recovered within 15 %, and switched on
-    (actual solves) the model meets the data to 1.5× the noise."""
+    the model meets the data to 1.5× the noise. (Its final RMSE comes from the tables: a series
+    element acts on the solved curve exactly as a single solve applies it, which
+    test_hysteresis_effect.py checks, so no re-solve is needed here.)"""
     meas = _measured_with_loop(tmp_path, specimens, tables, loop, LOOP_NOISE)
     diag = diagnose(meas, tables).to_dict()
     assert diag["verdict"]["missing_effect"] == "microslip_hysteresis", diag["verdict"]
+    assert diag["verdict"]["found_in_order"] == ["microslip_hysteresis"]
     est = next(r for r in diag["ranking"] if r["effect"] == "microslip_hysteresis")["params"]["loop_arcmin"]
     assert est == pytest.approx(loop, rel=0.15)
-    rmse = _rmse_switched_on(meas, specimens, {"microslip_hysteresis": {"loop_arcmin": est}})
-    assert rmse <= 1.5 * LOOP_NOISE, rmse
+    assert diag["final"]["effects"] == {"microslip_hysteresis": {"loop_arcmin": est}}
+    assert diag["final"]["rmse_arcmin"] <= 1.5 * LOOP_NOISE, diag["final"]
 
 
 def test_a_loop_no_candidate_offers_is_described_by_its_signature(tmp_path, specimens, tables):
-    """The same 0.2 arcmin loop with no hysteresis candidate offered: whatever the search makes
-    of it, the residual's signature names a hysteresis loop of the right width (within 20 %)."""
+    """The same 0.2 arcmin loop with no hysteresis candidate offered: the compliances pay by
+    absorbing the loop's mean curve (cup torsion halves the RMSE) but leave the loop itself, so
+    none is named: "no missing effect found", and the residual's signature names a hysteresis loop
+    of the right width (within 20 %) and the closest candidate."""
     meas = _measured_with_loop(tmp_path, specimens, tables, 0.2, LOOP_NOISE)
     others = [c for c in candidate_names({}) if c not in ("microslip_hysteresis", "tooth_friction")]
     diag = diagnose(meas, tables, Search(candidates=others)).to_dict()
+    assert diag["verdict"]["missing_effect"] is None and diag["verdict"]["text"] == "no missing effect found"
+    closest = diag["rounds"][0]["ranking"][0]
+    assert closest["pays"] and closest["takes_out"] is False
     sig = diag["signature"]
+    assert sig["dominant"] == "dead_band"
     gap = next(t for t in sig["terms"] if t["name"] == "dead_band")
     assert gap["value_arcmin"] == pytest.approx(0.2, rel=0.2)
     assert "a hysteresis loop" in sig["text"], sig["text"]
+    assert f"no candidate reproduces it (the closest, {closest['effect']}" in sig["text"], sig["text"]

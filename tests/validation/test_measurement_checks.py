@@ -2,6 +2,8 @@
 (issue 16): implausible readings, non-integer steps, unreadable files, zero or negative
 uncertainties, a flipped sign convention, and the checks of a campaign for one drive."""
 
+from dataclasses import replace
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -176,26 +178,22 @@ def test_a_campaign_for_one_drive_refuses_other_drives_and_bad_ids(tmp_path):
     assert len(lines) == 3, lines
 
 
-def test_a_campaign_whose_load_steps_do_not_match_the_data_stops_before_any_solve(tmp_path):
-    """The demo curves have 21 points (5 steps per ramp): the campaign's test must match them
-    step by step, else the measured point would be compared with another torque's model point."""
+def test_a_curve_logged_at_other_steps_or_run_minus_T_first_needs_no_renumbering():
+    """Points are compared with the model at their measured torque: the demo curves (5 steps per
+    ramp) against a campaign model of 4 or 8 steps per ramp, or run −T first, have no problem."""
     demo = load_measurements(SHIPPED / "demo_hd42.csv")
-    assert schedule_problems(demo, 5) == []
-    problems = schedule_problems(demo, 4)         # 17 steps: steps 17-20 do not exist, the rest mismatch
-    fields = {p[1] for p in problems}
-    assert fields == {"step", "torque_Nm"}
-    beyond = [p for p in problems if p[1] == "step"]
-    assert len(beyond) == 16 * 4 and {p[2] for p in beyond} == {17, 18, 19, 20}
-    assert "steps_per_ramp" in beyond[0][3]
+    assert schedule_problems(demo, 5) == schedule_problems(demo, 4) == schedule_problems(demo, 8) == []
+    data = demo.data.copy()
+    data["torque_Nm"], data["twist_arcmin"] = -data["torque_Nm"], -data["twist_arcmin"]
+    assert schedule_problems(replace(demo, data=data), 5) == []
 
 
-def test_a_test_run_minus_T_first_is_refused_with_the_reason(tmp_path):
-    data = pd.read_csv(SHIPPED / "demo_hd42.csv")
-    data["torque_Nm"] = -data["torque_Nm"]
-    data["twist_arcmin"] = -data["twist_arcmin"]      # a consistent test, loaded -T first
-    path = tmp_path / "minus_first.csv"
-    data.to_csv(path, index=False)
-    problems = schedule_problems(load_measurements(path), 5)   # the file itself is fine
-    first = min(problems, key=lambda p: p[0])
-    assert first[:3] == (2, "torque_Nm", data["torque_Nm"][1])  # step 1 of the first specimen
-    assert "−T first" in first[3] and "+0.192 N·m at step 1" in first[3]
+def test_a_torque_beyond_the_model_test_stops_before_any_solve(tmp_path):
+    """The model's curve ends at the test torque (0.96 N·m for HD 42): a reading past it by more
+    than a quarter of a load step would be compared with an extrapolation."""
+    df = _curve()
+    df.loc[2, "torque_Nm"] = 0.96 * (1 + 0.3 / 5)       # 0.3 of a load step beyond
+    df.loc[11, "torque_Nm"] = 0.96 * (1 + 0.2 / 5)      # within a quarter: the test torque
+    problems = schedule_problems(load_measurements(write_table(df, tmp_path)), 5)
+    assert [p[:3] for p in problems] == [(3, "torque_Nm", pytest.approx(1.0176))]
+    assert "beyond the campaign model's test torque ±0.96 N·m" in problems[0][3]

@@ -167,7 +167,7 @@ def test_lost_motion_data_has_bias_trends_and_scatter_only():
     assert sig.noise.flag is False
 
 
-def _measurements_and_tables(delta_T: float, w: float, n_spec=6, steps_per_ramp=5):
+def _measurements_and_tables(delta_T: float, w: float, n_spec=6, steps_per_ramp=5, u_stated=0.005):
     """A hand-made campaign: measurements (curve form) and tables of the model and of the thermal
     candidate, whose change is -0.002 dT * side (the dead band shrinks). The measurements hold
     thermal at ``delta_T`` and a loop of width ``w`` no candidate has."""
@@ -180,7 +180,7 @@ def _measurements_and_tables(delta_T: float, w: float, n_spec=6, steps_per_ramp=
         base = (0.3 + 0.01 * s) * side + 0.1 * T
         D = base - 0.002 * delta_T * side + w / 2 * side * u + 0.005 * rng.normal(size=len(T))
         data.append(pd.DataFrame({"specimen_id": f"S{s}", "unit": "hd42", **_params(s), "step": np.arange(len(T)),
-                                  "torque_Nm": T, "twist_arcmin": D, "u_twist_arcmin": 0.005}))
+                                  "torque_Nm": T, "twist_arcmin": D, "u_twist_arcmin": u_stated}))
         for v in plan_variants({}, ["thermal"]):
             dT = v.get("thermal", {}).get("delta_T_K", 0.0)
             table.append(pd.DataFrame({"specimen_id": f"S{s}", "variant": variant_key(v), "step": np.arange(len(T)),
@@ -208,6 +208,22 @@ def test_the_diagnosis_carries_the_signature():
     assert found["verdict"]["missing_effect"] == "thermal"
     assert found["signature"]["dominant"] == "dead_band"        # thermal narrows the play
     assert "thermal explained it" in found["signature"]["text"]
+
+
+def test_an_understated_uncertainty_is_replaced_by_the_data_scatter_in_the_detectability():
+    """Noise 0.005 arcmin in the data: stated as 0.005, the detectability is judged by it; stated
+    ten times smaller, the signature flags it and the detectability is judged by the scatter
+    estimated from the data instead (second differences, 6 × 21 points: within 25 %)."""
+    honest = diagnose(*_measurements_and_tables(0.0, 0.0), Search(candidates=["thermal"], max_rounds=1)).to_dict()
+    assert honest["detectability"]["noise_arcmin"] == pytest.approx(0.005)
+    assert honest["detectability"]["noise_from"] == "the noise stated in the measurement file"
+    low = diagnose(*_measurements_and_tables(0.0, 0.0, u_stated=0.0005),
+                   Search(candidates=["thermal"], max_rounds=1)).to_dict()
+    assert low["signature"]["noise"]["flag"] is True
+    assert low["detectability"]["noise_arcmin"] == pytest.approx(0.005, rel=0.25)
+    assert low["detectability"]["noise_arcmin"] == low["signature"]["noise"]["estimate_arcmin"]
+    assert low["detectability"]["noise_from"].startswith("the scatter estimated from the data")
+    assert low["noise_arcmin"] == pytest.approx(0.0005)     # what the file states stays on record
 
 
 def test_report_shows_the_signature():

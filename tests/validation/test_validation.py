@@ -78,6 +78,12 @@ def test_verdict_names_the_effect_ties_and_none():
     assert [r.effect for r in v.ranking] == ["tooth_friction", "cs_housing", "thermal"]
     none = verdict(base, [weak])
     assert none.missing_effect is None and "no missing effect" in none.text
+    # a candidate that pays but leaves the residual's clearest component is not named
+    v = verdict(base, [weak, twin, strong], takes_out={"tooth_friction": False, "cs_housing": True, "thermal": True})
+    assert v.missing_effect == "cs_housing" and v.indistinguishable_from == []
+    assert v.ranking[0].pays and v.ranking[0].takes_out is False
+    v = verdict(base, [twin, strong], takes_out={"tooth_friction": False, "cs_housing": False})
+    assert v.missing_effect is None and v.text == "no missing effect found"
 
 
 def _linear_response(g):

@@ -405,8 +405,10 @@ def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_r
 
     The bodies are assembled and factorised and the wave generator mounted once; each
     variant then switches its tooth-stage changes on a copy (a new CS factorisation only
-    when it changes the CS support) and runs the torque sequence.  Same numbers as
-    ``solve_lost_motion`` for each variant up to round-off.
+    when it changes the CS support) and runs the torque sequence. Variants that differ only
+    in their series elements (``ModelChanges.fe_part``) share one torque sequence: those
+    elements act on its output. Same numbers as ``solve_lost_motion`` for each variant up to
+    round-off.
 
     Parameters
     ----------
@@ -437,14 +439,16 @@ def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_r
     except Exception as exc:
         failed = _failed(exc, base, t0)
         return [failed for _ in variants]
-    out = []
+    out, solved = [], {}
     for ch in variants:
         t1 = time.perf_counter()
         model = None
         try:
-            model = base.fork()
-            model.apply_tooth_stage_changes(ch.fe_part())
-            test = _torque_test(model, frac, mounted, None)
+            if ch.fe_part() not in solved:
+                model = base.fork()
+                model.apply_tooth_stage_changes(ch.fe_part())
+                solved[ch.fe_part()] = (model, _torque_test(model, frac, mounted, None))
+            model, test = solved[ch.fe_part()]
             out.append(_result(model, ch, frac, mounted, test, t1))
         except Exception as exc:
             out.append(_failed(exc, model, t1))

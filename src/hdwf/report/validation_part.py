@@ -191,17 +191,25 @@ def _round_table(doc: Document, rnd: dict) -> None:
         rows.append([lit(r["effect"]), f"{lit(pname)} = {_estimate(val, r.get('param_sd'))}"
                      + (" (bound)" if r.get("at_bound") else "") + (" (off)" if r.get("calibrated_off") else ""),
                      fmt(r["rmse_arcmin"], 4), fmt(r["delta_bic"], 1), fmt(r["loo_rmse_arcmin"], 4),
-                     fmt(r["signature_match"], 2), "yes" if r["pays"] else "no"])
-    doc.table(["effect", "calibrated", "RMSE", "ΔBIC", "LOO RMSE", "match", "pays"], rows,
+                     fmt(r["signature_match"], 2), "yes" if r["pays"] else "no",
+                     {True: "yes", False: "no"}.get(r.get("takes_out"), "–")])
+    doc.table(["effect", "calibrated", "RMSE", "ΔBIC", "LOO RMSE", "match", "pays", "takes out"], rows,
               f"Round {rnd['round']}: every candidate calibrated on top of {cur} (RMSE "
               f"{fmt(rnd['current_rmse_arcmin'], 4)} arcmin). Pays: ΔBIC ≤ −10 and a lower leave-one-specimen-out "
-              "error; match: cosine between the change the effect makes and the residual (1 = same pattern).")
+              "error; match: cosine between the change the effect makes and the residual (1 = same pattern); "
+              "takes out: it leaves at most half of the residual's clearest component (the signature's dominant "
+              "term along the curve). Only a candidate that pays and takes it out is named.")
 
 
 def _round_verdict(rnd: dict) -> str:
     """One round's verdict in words: no missing effect, or the effect found and what it does."""
     v = rnd["verdict"]
     if v["missing_effect"] is None:
+        paying = [r["effect"] for r in rnd["ranking"] if r["pays"]]
+        if paying:
+            return (f"Round {rnd['round']}: *no missing effect found.* {lit(', '.join(paying))} lower the error "
+                    "beyond the data's scatter, but none takes out the residual's clearest component: each absorbs "
+                    "a share of a residual it cannot reproduce (the signature below says what is left).")
         return (f"Round {rnd['round']}: *no missing effect found.* No candidate lowers the error by more than "
                 "the data's scatter can explain (ΔBIC above −10, or no gain when a specimen is left out).")
     best = next(r for r in rnd["ranking"] if r["effect"] == v["missing_effect"])

@@ -212,6 +212,7 @@ class Ranked:
     delta_bic: float
     loo_rmse_arcmin: float
     pays: bool
+    takes_out: bool | None = None   # takes out the residual's clearest component (None: not judged)
 
 
 @dataclass
@@ -230,13 +231,15 @@ class Verdict:
 
 
 def verdict(baseline: Candidate, candidates: list[Candidate], pay_threshold: float = 10.0,
-            tie_threshold: float = 6.0) -> Verdict:
+            tie_threshold: float = 6.0, takes_out: dict[str, bool] | None = None) -> Verdict:
     """Rank candidates by ΔBIC against the baseline and decide.
 
     A candidate *pays* when ΔBIC ≤ −``pay_threshold`` (10: very strong evidence, Kass &
     Raftery 1995) and its leave-one-out error is below the baseline's. The missing effect
-    is the paying candidate of lowest BIC; paying candidates within ``tie_threshold`` of it
-    (less than strong evidence to prefer it) are reported as indistinguishable.
+    is the paying candidate of lowest BIC that takes out the residual's clearest component
+    (``takes_out``; one that pays by absorbing a share of a residual it cannot reproduce is
+    not named); paying candidates within ``tie_threshold`` of it (less than strong evidence
+    to prefer it) are reported as indistinguishable.
 
     Parameters
     ----------
@@ -246,6 +249,8 @@ def verdict(baseline: Candidate, candidates: list[Candidate], pay_threshold: flo
         The current model plus each candidate effect, calibrated.
     pay_threshold, tie_threshold : float
         ΔBIC a candidate must earn, and the gap below which two paying ones are a tie.
+    takes_out : dict, optional
+        ``{effect: bool}`` for the paying candidates (default: every candidate does).
 
     Returns
     -------
@@ -257,12 +262,13 @@ def verdict(baseline: Candidate, candidates: list[Candidate], pay_threshold: flo
     for c in candidates:
         d = bic(c.rss, c.n, c.k) - b0
         ranking.append(Ranked(c.effect, c.params, c.rmse, float(d), c.loo_rmse,
-                              bool(d <= -pay_threshold and c.loo_rmse < baseline.loo_rmse)))
+                              bool(d <= -pay_threshold and c.loo_rmse < baseline.loo_rmse),
+                              None if takes_out is None else takes_out.get(c.effect)))
     ranking.sort(key=lambda r: r.delta_bic)
-    paying = [r for r in ranking if r.pays]
-    if not paying:
+    named = [r for r in ranking if r.pays and r.takes_out is not False]
+    if not named:
         return Verdict(ranking, None, [], "no missing effect found")
-    best = paying[0]
-    ties = [r.effect for r in paying[1:] if r.delta_bic - best.delta_bic < tie_threshold]
+    best = named[0]
+    ties = [r.effect for r in named[1:] if r.delta_bic - best.delta_bic < tie_threshold]
     text = f"{best.effect} is missing" + (f"; the data cannot tell it from {', '.join(ties)}" if ties else "")
     return Verdict(ranking, best.effect, ties, text)

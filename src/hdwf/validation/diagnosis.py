@@ -40,8 +40,12 @@ from hdwf.validation.detectability import Visibility, detectability
 from hdwf.validation.effects import get as get_effect
 from hdwf.validation.measurements import Measurements
 from hdwf.validation.observations import observation_frame, predict, prediction_points
-from hdwf.validation.signature import ResidualSignature, residual_signature, with_verdict
+from hdwf.validation.signature import NoiseCheck, ResidualSignature, residual_signature, with_verdict
 from hdwf.validation.variants import candidate_names, variant_key
+
+
+# a candidate takes out a component of the residual when it leaves at most this share of it
+TAKE_OUT_SHARE = 0.5
 
 
 @dataclass(frozen=True)
@@ -208,8 +212,10 @@ def _evidence(resp: dict[str, Response], effect: str, f: Fit, current: Fit, resi
 class _GreedySearch:
     """The state of one search: the effects switched on, their joint fit, the rounds so far."""
 
-    def __init__(self, data: CalibrationData, specimen: np.ndarray, search: Search, resolver: Resolver | None):
+    def __init__(self, data: CalibrationData, specimen: np.ndarray, search: Search, resolver: Resolver | None,
+                 takes_out: Callable[[np.ndarray, np.ndarray], bool] | None = None):
         self.data, self.specimen, self.search, self.resolver = data, specimen, search, resolver
+        self.takes_out = takes_out   # (S before, S with a candidate) -> it takes out the clearest component
         self.refinement: dict[str, Refinement] = {}
         self.on: list[str] = []
         self.rounds: list[Round] = []
@@ -242,7 +248,8 @@ class _GreedySearch:
                                    loo_rmse(data, on + [e], f, self.specimen)))
             evidence[e] = _evidence(data.resp, e, f, fit, resid)
             fits[e] = f
-        v = verdict(cur, cands, self.search.pay_threshold, self.search.tie_threshold)
+        takes_out = {e: self.takes_out(fit.S, f.S) for e, f in fits.items()} if self.takes_out else None
+        v = verdict(cur, cands, self.search.pay_threshold, self.search.tie_threshold, takes_out)
         self.rounds.append(Round(number, list(on), cur.rmse, v, evidence))
         return fits
 
@@ -293,10 +300,15 @@ def _points(meas: Measurements, obs: pd.DataFrame, S_model: np.ndarray, S_final:
     return points
 
 
-def _noise(obs: pd.DataFrame, g: _GreedySearch) -> tuple[float | None, float, str]:
-    """The noise the file states (RMS, None when none), and the noise the detectability is judged by."""
+def _noise(obs: pd.DataFrame, g: _GreedySearch, check: NoiseCheck) -> tuple[float | None, float, str]:
+    """The noise the file states (RMS, None when none), and the noise the detectability is judged by:
+    the stated one, unless the signature's check found it far below the data's scatter (then that
+    estimate), or the final model's residual when none is stated."""
     u = obs["u_D"].to_numpy(float)
     noise = float(np.sqrt(np.nanmean(u ** 2))) if np.isfinite(obs["u_D"]).any() else None
+    if noise is not None and check.flag and check.estimate_arcmin:
+        return noise, check.estimate_arcmin, (f"the scatter estimated from the data ({check.estimate_from}): the "
+                                              f"stated uncertainty, {noise:.3g} arcmin RMS, is far below it")
     if noise is not None:
         return noise, noise, "the noise stated in the measurement file"
     sigma = float(np.sqrt(g.fit.rss / max(len(g.data.D) - len(g.on), 1)))
@@ -314,22 +326,48 @@ def _signature(form: str, base_points: pd.DataFrame, g: _GreedySearch, final_rms
                         first.current_rmse_arcmin)
 
 
+def _residual_points(meas: Measurements, obs: pd.DataFrame, S: np.ndarray) -> pd.DataFrame:
+    """The observations against a prediction, with each specimen's parameters (for the trends)."""
+    points = prediction_points(obs, S)
+    for c in meas.specimens.columns:
+        if c.endswith("_mm") and c not in points:
+            points = points.merge(meas.specimens[["specimen_id", c]], on="specimen_id")
+    return points
+
+
+def _component_judge(meas: Measurements, obs: pd.DataFrame) -> Callable[[np.ndarray, np.ndarray], bool]:
+    """``judge(S_before, S_after)``: does the change take out the clearest component of the
+    residual D − S_before (``ResidualSignature.clearest_component``)? Each of its terms must fall
+    to ``TAKE_OUT_SHARE`` of its size or below significance. True when nothing stands out."""
+    before: dict[bytes, ResidualSignature] = {}
+
+    def judge(S_before: np.ndarray, S_after: np.ndarray) -> bool:
+        key = np.asarray(S_before, float).tobytes()
+        if key not in before:
+            before[key] = residual_signature(_residual_points(meas, obs, S_before), meas.form)
+        sig = before[key]
+        if not sig.clearest_component:
+            return True
+        after = residual_signature(_residual_points(meas, obs, S_after), meas.form)
+        return all(not after.term(n).significant or abs(after.term(n).value) <= TAKE_OUT_SHARE * abs(sig.term(n).value)
+                   for n in sig.clearest_component)
+    return judge
+
+
 def _diagnosis(meas: Measurements, obs: pd.DataFrame, g: _GreedySearch, table_resp: dict[str, Response],
                notes: dict[str, str]) -> Diagnosis:
     """The result of a finished search."""
-    base_points = prediction_points(obs, g.data.S0)
-    for c in meas.specimens.columns:
-        if c.endswith("_mm") and c not in base_points:
-            base_points = base_points.merge(meas.specimens[["specimen_id", c]], on="specimen_id")
+    base_points = _residual_points(meas, obs, g.data.S0)
     summary, per = summarise(base_points)
     tests = residual_tests(base_points)
     resp, fit, n = g.data.resp, g.fit, len(g.data.D)
     found = [Found(e, fit.params(resp)[e], fit.param_sd(resp)[e]) for e in g.on]
-    noise, sigma, sigma_from = _noise(obs, g)
+    final_rmse = float(np.sqrt(fit.rss / n))
+    signature = _signature(meas.form, base_points, g, final_rmse)
+    noise, sigma, sigma_from = _noise(obs, g, signature.noise)
     units = meas.units
     pay = g.search.pay_threshold
     seen = detectability(table_resp, sigma, n, units[0] if len(units) == 1 else None, pay)
-    final_rmse = float(np.sqrt(fit.rss / n))
     return Diagnosis(
         form=meas.form, n_points=int(n), n_specimens=int(len(pd.unique(g.specimen))), noise_arcmin=noise,
         fixed=dict(g.search.fixed), calibrated_first=list(g.search.calibrate_first), baseline=summary,
@@ -337,7 +375,7 @@ def _diagnosis(meas: Measurements, obs: pd.DataFrame, g: _GreedySearch, table_re
         final_rmse_arcmin=final_rmse,
         detectability=DataDetectability(sigma, sigma_from, pay, seen), notes=notes, refinement=g.refinement,
         per_specimen=per, residual_tests=tests, points=_points(meas, obs, g.data.S0, fit.S, base_points),
-        signature=_signature(meas.form, base_points, g, final_rmse))
+        signature=signature)
 
 
 def diagnose(meas: Measurements, table: pd.DataFrame, search: Search | None = None,
@@ -373,7 +411,7 @@ def diagnose(meas: Measurements, table: pd.DataFrame, search: Search | None = No
     data, candidates, notes = _calibration_data(table, obs, search)
     table_resp = dict(data.resp)        # the tables' splines; ``data.resp`` may get anchored ones
     resolver = None if solve is None else Resolver(solve, obs, dict(search.fixed), table_resp)
-    g = _GreedySearch(data, obs["specimen_id"].to_numpy(), search, resolver)
+    g = _GreedySearch(data, obs["specimen_id"].to_numpy(), search, resolver, _component_judge(meas, obs))
     g.calibrate_first(list(search.calibrate_first))
     g.run(candidates)
     return _diagnosis(meas, obs, g, table_resp, notes)

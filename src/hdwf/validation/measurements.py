@@ -28,7 +28,6 @@ import pyarrow as pa
 
 from hdwf import PARAMETER_COLUMNS, PARAMETERS, UNITS
 from hdwf.common.errors import InputError
-from hdwf.fe import torque_fractions
 from hdwf.drive.geometry import unit_data
 
 ID_COLUMNS = ["specimen_id", "unit", *PARAMETER_COLUMNS]
@@ -413,18 +412,18 @@ def _specimen_table(data: pd.DataFrame, form: str) -> pd.DataFrame:
 
 
 def schedule_problems(meas: Measurements, steps_per_ramp: int) -> list[tuple]:
-    """Curve points the model's test has no match for, found before any solve.
+    """Curve points beyond the campaign model's test, found before any solve.
 
-    A curve is compared with the model step by step; the model loads 0 → +T → 0 → −T → 0 in
-    ``steps_per_ramp`` steps per ramp (``hdwf.fe.torque_fractions``). A measured step outside
-    that test, or at a torque more than a quarter of a load step from the model's torque at the
-    same step (another number of steps per ramp, a test run −T first), would be compared with
-    the wrong model point.
+    A curve point is compared with the model at its measured torque (``observations.predict``):
+    any step numbering, a test run −T first or a curve logged at its own torques meets the model
+    where it was measured. The model's test goes to ± the test torque in ``steps_per_ramp``
+    steps per ramp, so a measured torque more than a quarter of a load step beyond it would be
+    compared with an extrapolation; those points are refused.
 
     Parameters
     ----------
     meas : Measurements
-        A checked file (``load_measurements``); only the curve form has steps.
+        A checked file (``load_measurements``); only the curve form has torques.
     steps_per_ramp : int
         The campaign's load steps per ramp.
 
@@ -435,22 +434,11 @@ def schedule_problems(meas: Measurements, steps_per_ramp: int) -> list[tuple]:
     """
     if meas.form != "curve":
         return []
-    fractions = torque_fractions(steps_per_ramp)
     d = meas.data
-    step, torque = d["step"].to_numpy(int), d["torque_Nm"].to_numpy(float)
+    torque = d["torque_Nm"].to_numpy(float)
     test = np.array([lost_motion_test_torque_Nm(u) for u in d["unit"]])
-    inside = (step >= 0) & (step < len(fractions))
-    model = np.where(inside, fractions[np.clip(step, 0, len(fractions) - 1)], np.nan) * test
-    off = inside & (np.abs(torque - model) > 0.25 * test / steps_per_ramp)
-    problems = []
-    for i in np.flatnonzero(~inside | off):
-        if not inside[i]:
-            problems.append((i + 1, "step", int(step[i]), f"not a step of the campaign's test (steps 0-{len(fractions) - 1} "
-                                                          f"at steps_per_ramp {steps_per_ramp}); set the campaign's "
-                                                          "steps_per_ramp to match the data"))
-        else:
-            problems.append((i + 1, "torque_Nm", float(torque[i]),
-                             f"the campaign's test (0 → +T → 0 → −T → 0, steps_per_ramp {steps_per_ramp}) is at "
-                             f"{model[i]:+.4g} N·m at step {int(step[i])}: another number of steps per ramp, or a test "
-                             "run −T first? set the campaign's steps_per_ramp, or number the steps in the model's order"))
-    return problems
+    beyond = np.abs(torque) > test * (1.0 + 0.25 / steps_per_ramp)
+    return [(i + 1, "torque_Nm", float(torque[i]),
+             f"beyond the campaign model's test torque ±{test[i]:.4g} N·m (by more than a quarter of a load step "
+             f"at steps_per_ramp {steps_per_ramp}); the model is not extrapolated: drop the point or check the unit")
+            for i in np.flatnonzero(beyond)]

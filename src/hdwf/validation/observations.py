@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from hdwf.validation.comparison import comparison_points
+from hdwf.validation.comparison import branches, comparison_points
 from hdwf.validation.measurements import Measurements
 
 
@@ -53,6 +53,10 @@ def observation_frame(meas: Measurements) -> pd.DataFrame:
 def predict(table: pd.DataFrame, obs: pd.DataFrame, variant: str) -> np.ndarray:
     """The model's value of every observation for one variant.
 
+    A curve point is compared with the model at its measured torque, on the branch of the
+    same kind (``twist_along_test``), so a test logged at other torques, in other steps or run −T
+    first meets the model where it was measured.
+
     Parameters
     ----------
     table : pandas.DataFrame
@@ -71,15 +75,14 @@ def predict(table: pd.DataFrame, obs: pd.DataFrame, variant: str) -> np.ndarray:
     ------
     KeyError
         When the variant, or a specimen's solve of it, is not in the table.
-    ValueError
-        When a measured step is not a step of the model's test.
     """
     t = table[table["variant"] == variant]
     if t.empty:
         raise KeyError(f"variant {variant!r} is not in the table")
+    obs = obs.reset_index(drop=True)   # positions, whatever the caller's index
     out = np.full(len(obs), np.nan)
     curves = {sid: g.sort_values("step") for sid, g in t.groupby("specimen_id", sort=False)}
-    for i, (sid, q) in enumerate(zip(obs["specimen_id"], obs["quantity"])):
+    for sid, rows in obs.groupby("specimen_id", sort=False):
         g = curves.get(sid)
         if g is None:
             raise KeyError(f"specimen {sid!r} has no solve for variant {variant!r}")
@@ -87,16 +90,71 @@ def predict(table: pd.DataFrame, obs: pd.DataFrame, variant: str) -> np.ndarray:
         T = g["torque_Nm"].to_numpy(float)
         if not np.isfinite(tw).all():        # this variant's solve failed for this specimen
             continue
-        if q == "twist":
-            hit = tw[g["step"].to_numpy() == obs["step"].iloc[i]]
-            if hit.size == 0:
-                raise ValueError(f"specimen {sid!r}: measured step {obs['step'].iloc[i]} is not a step of the "
-                                 f"model's test ({len(tw)} steps); set the campaign's steps_per_ramp to match")
-            out[i] = hit[0]
-        else:
+        is_twist = (rows["quantity"] == "twist").to_numpy()
+        if is_twist.any():
+            curve = rows[is_twist].sort_values("step", kind="stable")
+            out[curve.index.to_numpy()] = twist_along_test(T, tw, curve["torque_Nm"].to_numpy(float))
+        if (~is_twist).any():
             kp, km = int(np.nanargmax(T)), int(np.nanargmin(T))
-            phi_p, phi_m = tw[kp], -tw[km]
-            out[i] = {"phi_plus": phi_p, "phi_minus": phi_m, "lost_motion": phi_p + phi_m}[q]
+            value = {"phi_plus": tw[kp], "phi_minus": -tw[km], "lost_motion": tw[kp] - tw[km]}
+            out[rows.index[~is_twist].to_numpy()] = [value[q] for q in rows["quantity"][~is_twist]]
+    return out
+
+
+def twist_along_test(model_torque: np.ndarray, model_twist: np.ndarray, torque: np.ndarray) -> np.ndarray:
+    """The model's twist along a measured test, whichever way it was loaded first.
+
+    The model's test loads +T first, from a state leaning towards its first load (its
+    zero-torque convention, docs/fe-model.md). The section and every effect are symmetric
+    under a mirror through the major axis, which turns +T into −T, so the model's test run
+    −T first is the mirror image of its own: a measured test whose first non-zero torque is
+    negative is compared with ``-branch_twist(model, -torque)``.
+
+    Parameters
+    ----------
+    model_torque, model_twist : numpy.ndarray
+        The model's test 0 → +T → 0 → −T → 0, in its order.
+    torque : numpy.ndarray
+        One specimen's measured torques, in test order.
+
+    Returns
+    -------
+    numpy.ndarray
+        The model's twist at each measured point (``branch_twist``).
+    """
+    loaded = np.flatnonzero(torque)
+    if loaded.size and torque[loaded[0]] < 0:
+        return -branch_twist(model_torque, model_twist, -torque)
+    return branch_twist(model_torque, model_twist, torque)
+
+
+def branch_twist(model_torque: np.ndarray, model_twist: np.ndarray, torque: np.ndarray) -> np.ndarray:
+    """The model's twist at measured torques, each on the branch it was measured on.
+
+    Both tests are split into branches by ``comparison.branches`` (load± while |T| rises,
+    unload± while it falls); a measured point takes the model's twist interpolated linearly in
+    |T| on the model's branch of the same kind (from the point that starts it), so measured
+    torques on the model's steps get the model's values exactly. Parameters as
+    ``twist_along_test``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The model's twist at each measured torque; a torque beyond the model's test torque takes
+        the twist at the test torque (``measurements.schedule_problems`` refuses those first).
+    """
+    model_branch = np.asarray(branches(model_torque))
+    measured_branch = np.asarray(branches(torque))
+    out = np.full(len(torque), np.nan)
+    for b in np.unique(measured_branch):
+        idx = np.flatnonzero(model_branch == b)
+        if idx.size == 0:
+            raise ValueError(f"the model's test has no {b} branch")
+        idx = np.concatenate([[idx[0] - 1], idx]) if idx[0] > 0 else idx
+        x, y = np.abs(model_torque[idx]), model_twist[idx]
+        order = np.argsort(x, kind="stable")
+        mine = measured_branch == b
+        out[mine] = np.interp(np.abs(torque[mine]), x[order], y[order])
     return out
 
 

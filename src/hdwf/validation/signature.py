@@ -15,12 +15,10 @@ signature"):
   same sign, interpolated at the same |T|): the measured loop minus the model's, over all pairs and
   per torque level;
 * ``trend_<param>``: slope of the per-specimen mean r on each input (arcmin per µm) and its R²;
-* noise: the median stated u against an estimate from the data: for curves from the second
-  differences of r along each branch (var(r[i-1] - 2 r[i] + r[i+1]) = 6 σ² for white noise), else
-  from the scatter of r after its regression on the inputs; a stated u absent, zero or more than
-  ``NOISE_FLAG_RATIO`` below the estimate is flagged.
+* noise: the median stated u against an estimate from the data (second differences along each
+  branch, or the scatter after the inputs' regression), flagged ``NOISE_FLAG_RATIO`` below it.
 
-The dominant term is the significant one largest against its se. Fits: statsmodels OLS.
+The dominant term is the significant one largest against its se (statsmodels OLS fits).
 """
 
 from __future__ import annotations
@@ -156,6 +154,20 @@ class ResidualSignature:
         """The significant term largest against its se (None when no term is significant)."""
         sig = [t for t in self.terms if t.significant]
         return max(sig, key=lambda t: t.z).name if sig else None
+
+    @property
+    def clearest_component(self) -> tuple[str, ...]:
+        """What a candidate must take out: the significant term along the curve largest against its
+        se (a trend with an input only when none stands out: its se counts every point, though the
+        specimens alone carry it); a hysteresis loop (``_dominant_phrase``) is two terms."""
+        sig = [t for t in self.terms if t.significant]
+        pool = [t for t in sig if not t.name.startswith("trend_")] or sig
+        if not pool:
+            return ()
+        dom, loop = max(pool, key=lambda t: t.z), self.term("loop_width")
+        if dom.name == "dead_band" and dom.value > 0 and loop is not None and loop.significant and loop.value > 0:
+            return ("dead_band", "loop_width")
+        return (dom.name,)
 
     def term(self, name: str) -> SignatureTerm | None:
         """The term called ``name`` (None when it was not computed)."""
@@ -357,22 +369,20 @@ def noise_check(stated: np.ndarray, estimate: float | None, estimate_from: str, 
     Returns
     -------
     NoiseCheck
-        With the note the report prints (the diagnosis's numbers are not switched to the estimate).
+        With the note the report prints (when flagged, the diagnosis judges detectability by the estimate).
     """
     u = np.asarray(stated, float)
     med = float(np.median(u[np.isfinite(u)])) if np.isfinite(u).any() else None
-    if not estimate:
+    if not estimate or (med is not None and med * NOISE_FLAG_RATIO >= estimate):
         return NoiseCheck(med, estimate, estimate_from, n_used, False, "")
     if med is None:
         note = (f"no uncertainty is stated; the scatter estimated from the data is {estimate:.3g} arcmin "
                 "(the detectability uses the final model's residual instead, an upper bound)")
         return NoiseCheck(med, estimate, estimate_from, n_used, True, note)
-    if med * NOISE_FLAG_RATIO >= estimate:
-        return NoiseCheck(med, estimate, estimate_from, n_used, False, "")
     note = (f"stated uncertainty {med:.3f} arcmin is far below the scatter {estimate:.3g} arcmin estimated from "
-            "the data; the estimate is used to read this signature. The verdict (ΔBIC, leave-one-out error) does "
-            "not use the stated uncertainty; the detectability table and u_val do and were not switched: they "
-            "overstate what this data can show")
+            "the data; the estimate is used to read this signature and to judge what the data can show (the "
+            "detectability table). The verdict (ΔBIC, leave-one-out error) does not use the stated uncertainty; "
+            "u_val does, so it understates the comparison's uncertainty")
     return NoiseCheck(med, estimate, estimate_from, n_used, True, note)
 
 
@@ -422,7 +432,7 @@ def _dominant_phrase(sig: ResidualSignature, dom: SignatureTerm) -> str:
     """The dominant term in words. A wider gap at zero torque whose branches stay apart under load
     too is a hysteresis loop, not play: a dead band closes as soon as the torque is non-zero."""
     loop = sig.term("loop_width")
-    if dom.name == "dead_band" and dom.value > 0 and loop is not None and loop.significant and loop.value > 0:
+    if sig.clearest_component == ("dead_band", "loop_width") and dom.name == "dead_band":
         return (f"a hysteresis loop {_phrase(dom, bare=True)} arcmin wide at zero torque whose branches stay "
                 f"{_phrase(loop, bare=True)} arcmin apart under load (play would close under load)")
     return _phrase(dom)
