@@ -427,9 +427,7 @@ def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_r
         One per variant, in order.
     """
     if geom.interference_m > 0:
-        # preloaded teeth are in from the mount on, and friction or the CS support change
-        # the preload: every variant mounts its own wave generator
-        return [solve_lost_motion(geom, mesh, steps_per_ramp, changes=ch) for ch in variants]
+        return _preloaded_variants(geom, mesh, steps_per_ramp, variants)
     t0 = time.perf_counter()
     frac = torque_fractions(steps_per_ramp)
     base = None
@@ -452,4 +450,28 @@ def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_r
             out.append(_result(model, ch, frac, mounted, test, t1))
         except Exception as exc:
             out.append(_failed(exc, model, t1))
+    return out
+
+
+def _preloaded_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int,
+                        variants: list[ModelChanges]) -> list[LostMotionResult]:
+    """Preloaded teeth are in from the mount on, and friction or the CS support change the
+    preload: each variant that changes the section mounts its own wave generator; variants
+    that differ only in series elements share that mount and torque sequence."""
+    frac = torque_fractions(steps_per_ramp)
+    out, solved = [], {}
+    for ch in variants:
+        t1 = time.perf_counter()
+        key = ch.fe_part()
+        if key not in solved:
+            model = None
+            try:
+                model = LostMotionModel(geom, mesh, changes=key, zone_deg=_zone(geom, None))
+                mounted = _mount_wave_generator(model, True)
+                solved[key] = (model, mounted, _torque_test(model, frac, mounted, None), None)
+            except Exception as exc:   # any failure is reported, never a silent number
+                solved[key] = (model, None, None, exc)
+        model, mounted, test, exc = solved[key]
+        out.append(_failed(exc, model, t1) if exc is not None
+                   else _result(model, ch, frac, mounted, test, t1))
     return out
