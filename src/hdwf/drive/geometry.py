@@ -48,6 +48,8 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 from scipy.optimize import brentq
 
+from hdwf.drive.relief import tip_relief
+
 ARCMIN = math.pi / (180.0 * 60.0)  # rad per arcmin
 
 # --------------------------------------------------------------------------------------
@@ -206,6 +208,8 @@ class DriveGeometry:
     cam_n: float
     # preloaded engagement: normal flank interference of the nominal design, in units of m
     interference_m: float = 0.0
+    # tip relief, in units of the relief the FS tooth's path needs (``hdwf.drive.relief``)
+    tip_relief: float = 0.0
 
     # ---- derived quantities -------------------------------------------------------
     @property
@@ -217,6 +221,26 @@ class DriveGeometry:
     def interference(self) -> float:
         """Normal interference per flank (mm) the FS teeth are made thicker by (preload)."""
         return self.interference_m * self.module
+
+    @property
+    def addendum(self) -> float:
+        """Addendum h_a of FS and CS teeth (mm)."""
+        return self.r_fs_tip - self.r_fs_pitch
+
+    def relief(self, depth):
+        """Tangential tip relief (mm) of a flank ``depth`` (mm) below its tooth's tip:
+        ``tip_relief`` times ``hdwf.drive.relief.tip_relief``."""
+        if not self.tip_relief:
+            return 0.0
+        return self.tip_relief * tip_relief(depth, self.module, self.addendum, self.alpha,
+                                            self.tilt_factor)
+
+    @property
+    def tilt_factor(self) -> float:
+        """kappa = 1 - 3 (r_tip - r_n) / r_n: the FS tip's tangential displacement over the
+        wall mid-line's (the cross-section turns with the ring; ``hdwf.drive.relief``)."""
+        r_n = 0.5 * (self.r_fs_bore + self.r_fs_root)
+        return 1.0 - 3.0 * (self.r_fs_tip - r_n) / r_n
 
     @property
     def r_fs_base(self) -> float:
@@ -321,8 +345,9 @@ def fs_half_angle(g: DriveGeometry, r):
     r = np.asarray(r, dtype=float)
     rb = g.r_fs_base
     ar = np.arccos(np.clip(rb / r, -1, 1))
-    return ((math.pi * g.module / 2) / (2 * g.r_fs_pitch) + inv(g.alpha) - inv(ar)
-            - (g.r_fs - g.interference) / rb)
+    out = ((math.pi * g.module / 2) / (2 * g.r_fs_pitch) + inv(g.alpha) - inv(ar)
+           - (g.r_fs - g.interference) / rb)
+    return out - g.relief(g.r_fs_tip - r) / r if g.tip_relief else out
 
 
 def cs_half_space_angle(g: DriveGeometry, r):
@@ -334,7 +359,8 @@ def cs_half_space_angle(g: DriveGeometry, r):
     r = np.asarray(r, dtype=float)
     rb = g.r_cs_base
     ar = np.arccos(np.clip(rb / r, -1, 1))
-    return (math.pi * g.module / 2) / (2 * g.r_cs_pitch) + inv(g.alpha) - inv(ar) + g.r_cs / rb
+    out = (math.pi * g.module / 2) / (2 * g.r_cs_pitch) + inv(g.alpha) - inv(ar) + g.r_cs / rb
+    return out + g.relief(r - g.r_cs_tip) / r if g.tip_relief else out
 
 
 # --------------------------------------------------------------------------------------
@@ -363,7 +389,8 @@ def geometric_backlash_arcmin(g: DriveGeometry, radial_shortfall_mm: float = 0.0
 # Builder
 # --------------------------------------------------------------------------------------
 def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: float,
-                   rCS_mm: float, interference_m: float = 0.0) -> DriveGeometry:
+                   rCS_mm: float, interference_m: float = 0.0,
+                   tip_relief: float = 0.0) -> DriveGeometry:
     """Geometry of one design of unit "hd42" or "hd120" (all lengths in mm).
 
     ``interference_m`` (>= 0, units of the module m): preloaded engagement.  The FS teeth
@@ -372,9 +399,16 @@ def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: fl
     its CS space by that much on both flanks: the wave generator presses it in as a
     preloaded wedge, and r_FS + r_CS first relieve that preload before clearance opens.
     0 (the default) is the zero-interference design of the 2-tooth difference.
+
+    ``tip_relief`` (>= 0): FS and CS tips relieved by this multiple of the relief the FS
+    tooth's path needs to leave the mesh without crossing the CS tips
+    (``hdwf.drive.relief``); 0 (the default) keeps the plain involutes, whose tips cross
+    51-69 deg from the major axis.
     """
     if not (interference_m >= 0.0 and math.isfinite(interference_m)):
         raise ValueError(f"interference_m must be finite and >= 0, got {interference_m!r}")
+    if not (tip_relief >= 0.0 and math.isfinite(tip_relief)):
+        raise ValueError(f"tip_relief must be finite and >= 0, got {tip_relief!r}")
     t = asdict(unit_data(unit))
     m = t["module"]
     h = t["tooth_height"]
@@ -401,6 +435,7 @@ def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: fl
         r_cs_tip=r_cs_pitch - ha, r_cs_pitch=r_cs_pitch, r_cs_root=r_cs_pitch + hf,
         r_cs_outer=r_cs_pitch + hf + t["cs_rim"],
         cam_A=A, cam_B=B, cam_n=t["cam_n"], interference_m=float(interference_m),
+        tip_relief=float(tip_relief),
     )
 
 

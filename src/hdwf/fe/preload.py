@@ -133,6 +133,8 @@ def mount_preloaded(model: LostMotionModel, level: LevelSolution) -> tuple[Level
         hold = new_hold
         # intermediate steps only have to keep the ramp on its path; the last one is exact
         level, err = _settle(model, nodes, hold, level, GEO_TOL if k == steps else STEP_TOL)
+    if overlap <= 0:     # no tooth overlaps: one solve with the tooth rows in (true gaps)
+        level, err = _settle(model, nodes, 0.0, level, GEO_TOL)
     check = tooth_rows(st, geom, level.u_watch, np.inf, nodes=nodes)
     pen = max(0.0, float(-(check.g0 + check.G @ level.u_watch).min()))
     if pen > GEO_TOL + model.solver.settings.tol_gap:
