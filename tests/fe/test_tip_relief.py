@@ -37,7 +37,7 @@ def test_relief_covers_the_crossing_and_no_more(unit):
     the least relief split evenly.  Below the start depth both flanks are untouched."""
     g = drive_geometry(unit, *NOMINAL[unit], tip_relief=1.0)
     ha = g.addendum
-    c = lambda d: tip_relief(d, g.module, ha, g.alpha, g.tilt_factor)   # noqa: E731
+    c = lambda d: tip_relief(d, g.module, ha, g.alpha, g.tilt_factor)
     phi = np.radians(np.linspace(1.0, 89.0, 400))
     delta, _, e = _path(g, phi)
     band = 2 * ha - delta

@@ -87,7 +87,7 @@ def relief_start_depth(module: float, addendum: float, alpha: float,
                        kappa: float = 1.0) -> float:
     """Depth below the tip (mm) where the relief starts (e = 0 on the path); 0 if none."""
     lo, hi = math.pi / 3, math.pi           # the exit root (e < 0 at 60 deg of 2 phi)
-    f = lambda t: _advance(t, kappa) - math.tan(alpha) * (1.0 - math.cos(t))   # noqa: E731
+    f = lambda t: _advance(t, kappa) - math.tan(alpha) * (1.0 - math.cos(t))
     for _ in range(100):                    # bisection: f < 0 below its root, > 0 above
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if f(mid) < 0 else (lo, mid)
