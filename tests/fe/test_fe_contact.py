@@ -26,3 +26,22 @@ def test_closest_segment_gap_is_corner_distance_beyond_a_segment():
     assert (seg[0], t[0]) in [(0, 1.0), (1, 0.0)]    # the corner, from either segment
     assert gap[1] == pytest.approx(0.2) and seg[1] == 0
     assert gap[2] == pytest.approx(-0.05) and seg[2] == 0
+
+
+def test_closest_segment_gap_is_negative_when_sunk_in_at_a_concave_vertex():
+    """Two segments meeting at a concave vertex (0, 0) of the material below them (an
+    internal gear's flank is such a polyline), outward normals pointing up-and-in.  A point
+    that has sunk in just under the vertex projects beyond the ends of both segments; it lies
+    behind both, so it penetrates by its distance to the vertex (a convex corner's fan always
+    lies in front of one of its segments).  Before this rule it was reported as a gap of that
+    distance: with a preload the ramp saw 65 um jumps."""
+    xa = np.array([[-1.0, 0.0], [0.5, 0.0]])          # (-1, 0.5) -> (0, 0) -> (1, 0.5)
+    xb = np.array([[0.0, 1.0], [0.0, 0.5]])
+    d = xb - xa
+    nrm = np.vstack([-d[1], d[0]]) / np.linalg.norm(d, axis=0)   # left-hand normals: up
+    assert nrm[1].min() > 0
+    pts = np.array([[0.0, -0.03], [0.0, 0.3], [-0.5, 0.2]]).T
+    gap, seg, _ = closest_segments(pts, xa, xb, nrm)
+    assert gap[0] == pytest.approx(-0.03)                          # sunk in at the vertex
+    assert gap[1] > 0                                               # above it: outside
+    assert gap[2] == pytest.approx((0.2 - 0.25) * 2 / math.sqrt(5)) and seg[2] == 0

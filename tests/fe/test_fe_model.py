@@ -122,7 +122,8 @@ def test_full_fields_reproduce_the_contact_solution(monkeypatch, symmetry):
     r = solve_lost_motion(g, build_mesh(g, **COARSE, symmetry=symmetry), steps_per_ramp=1,
                           keep_fields=True)
     assert r.status == "ok", r.reason
-    assert set(r.fields) == {"wg", "plus"} and len(diffs) == 2
+    # wg, the check of the teeth outside the zones at the mount, plus
+    assert set(r.fields) == {"wg", "plus"} and len(diffs) == 3
     assert max(diffs) < 1e-9  # mm
     # the mounted wave generator pushes the FS out at the major axis by about w0 = m
     assert r.wg_deflection_um > 0.5 * g.w0 * 1000

@@ -23,6 +23,9 @@ Contents
   (wider spaces, larger dimension between pins), as in the paper's Fig. 5.  Zero offsets
   are the nominal zero-backlash design: with the nominal bearing the major-axis FS tooth
   then sits in its CS space touching both flanks at the pitch point.
+* preloaded engagement (``interference_m``, units of m, default 0): the FS flanks are
+  thickened by a normal offset interference_m * m, so the wave generator presses the
+  teeth into the CS spaces (a preloaded wedge) and r_FS + r_CS first relieve that preload.
 * ``geometric_backlash_rad/arcmin``: the rigid-body backlash the offsets create.
 
 Levels versus the paper (read before comparing numbers): a normal flank offset r opens a
@@ -44,6 +47,8 @@ from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 from scipy.optimize import brentq
+
+from hdwf.drive.relief import tip_relief
 
 ARCMIN = math.pi / (180.0 * 60.0)  # rad per arcmin
 
@@ -201,12 +206,41 @@ class DriveGeometry:
     cam_A: float
     cam_B: float
     cam_n: float
+    # preloaded engagement: normal flank interference of the nominal design, in units of m
+    interference_m: float = 0.0
+    # tip relief, in units of the relief the FS tooth's path needs (``hdwf.drive.relief``)
+    tip_relief: float = 0.0
 
     # ---- derived quantities -------------------------------------------------------
     @property
     def w0(self) -> float:
         """Design radial deflection of the FS at the major axis (2-tooth difference)."""
         return self.module * (self.z_cs - self.z_fs) / 2.0
+
+    @property
+    def interference(self) -> float:
+        """Normal interference per flank (mm) the FS teeth are made thicker by (preload)."""
+        return self.interference_m * self.module
+
+    @property
+    def addendum(self) -> float:
+        """Addendum h_a of FS and CS teeth (mm)."""
+        return self.r_fs_tip - self.r_fs_pitch
+
+    def relief(self, depth):
+        """Tangential tip relief (mm) of a flank ``depth`` (mm) below its tooth's tip:
+        ``tip_relief`` times ``hdwf.drive.relief.tip_relief``."""
+        if not self.tip_relief:
+            return 0.0
+        return self.tip_relief * tip_relief(depth, self.module, self.addendum, self.alpha,
+                                            self.tilt_factor)
+
+    @property
+    def tilt_factor(self) -> float:
+        """kappa = 1 - 3 (r_tip - r_n) / r_n: the FS tip's tangential displacement over the
+        wall mid-line's (the cross-section turns with the ring; ``hdwf.drive.relief``)."""
+        r_n = 0.5 * (self.r_fs_bore + self.r_fs_root)
+        return 1.0 - 3.0 * (self.r_fs_tip - r_n) / r_n
 
     @property
     def r_fs_base(self) -> float:
@@ -305,12 +339,15 @@ def fs_half_angle(g: DriveGeometry, r):
     """Half tooth-thickness angle of an FS tooth at radius r (tooth centred on angle 0).
 
     Nominal arc thickness at the pitch circle is pi m / 2; the normal offset r_FS on each
-    flank rotates that involute by r_FS / r_b towards the tooth centre.
+    flank rotates that involute by r_FS / r_b towards the tooth centre, the preload
+    interference (``interference``, a thickness allowance) by as much away from it.
     """
     r = np.asarray(r, dtype=float)
     rb = g.r_fs_base
     ar = np.arccos(np.clip(rb / r, -1, 1))
-    return (math.pi * g.module / 2) / (2 * g.r_fs_pitch) + inv(g.alpha) - inv(ar) - g.r_fs / rb
+    out = ((math.pi * g.module / 2) / (2 * g.r_fs_pitch) + inv(g.alpha) - inv(ar)
+           - (g.r_fs - g.interference) / rb)
+    return out - g.relief(g.r_fs_tip - r) / r if g.tip_relief else out
 
 
 def cs_half_space_angle(g: DriveGeometry, r):
@@ -322,7 +359,8 @@ def cs_half_space_angle(g: DriveGeometry, r):
     r = np.asarray(r, dtype=float)
     rb = g.r_cs_base
     ar = np.arccos(np.clip(rb / r, -1, 1))
-    return (math.pi * g.module / 2) / (2 * g.r_cs_pitch) + inv(g.alpha) - inv(ar) + g.r_cs / rb
+    out = (math.pi * g.module / 2) / (2 * g.r_cs_pitch) + inv(g.alpha) - inv(ar) + g.r_cs / rb
+    return out + g.relief(r - g.r_cs_tip) / r if g.tip_relief else out
 
 
 # --------------------------------------------------------------------------------------
@@ -336,9 +374,10 @@ def geometric_backlash_rad(g: DriveGeometry, radial_shortfall_mm: float = 0.0) -
     normal clearance on each flank is r_FS + r_CS (+ radial_shortfall * sin(alpha) if the
     FS does not reach the full deflection w0), and a rigid FS rotation psi about the drive
     centre closes it at the rate |x_P x n| = r_pCS cos(alpha) = r_b,CS.  The FS can turn
-    both ways, so Phi = 2 (r_FS + r_CS + dr sin alpha) / r_b,CS.
+    both ways, so Phi = 2 (r_FS + r_CS + dr sin alpha) / r_b,CS.  A preload interference
+    delta enters as -delta (a negative result is a preloaded, rigidly locked pair).
     """
-    gap = g.r_fs + g.r_cs + radial_shortfall_mm * math.sin(g.alpha)
+    gap = g.r_fs + g.r_cs - g.interference + radial_shortfall_mm * math.sin(g.alpha)
     return 2.0 * gap / g.r_cs_base
 
 
@@ -350,8 +389,26 @@ def geometric_backlash_arcmin(g: DriveGeometry, radial_shortfall_mm: float = 0.0
 # Builder
 # --------------------------------------------------------------------------------------
 def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: float,
-                   rCS_mm: float) -> DriveGeometry:
-    """Geometry of one design of unit "hd42" or "hd120" (all lengths in mm)."""
+                   rCS_mm: float, interference_m: float = 0.0,
+                   tip_relief: float = 0.0) -> DriveGeometry:
+    """Geometry of one design of unit "hd42" or "hd120" (all lengths in mm).
+
+    ``interference_m`` (>= 0, units of the module m): preloaded engagement.  The FS teeth
+    are made thicker by a normal offset of interference_m * m on each flank (a tooth
+    thickness allowance), so with the nominal bearing the major-axis tooth would overlap
+    its CS space by that much on both flanks: the wave generator presses it in as a
+    preloaded wedge, and r_FS + r_CS first relieve that preload before clearance opens.
+    0 (the default) is the zero-interference design of the 2-tooth difference.
+
+    ``tip_relief`` (>= 0): FS and CS tips relieved by this multiple of the relief the FS
+    tooth's path needs to leave the mesh without crossing the CS tips
+    (``hdwf.drive.relief``); 0 (the default) keeps the plain involutes, whose tips cross
+    51-69 deg from the major axis.
+    """
+    if not (interference_m >= 0.0 and math.isfinite(interference_m)):
+        raise ValueError(f"interference_m must be finite and >= 0, got {interference_m!r}")
+    if not (tip_relief >= 0.0 and math.isfinite(tip_relief)):
+        raise ValueError(f"tip_relief must be finite and >= 0, got {tip_relief!r}")
     t = asdict(unit_data(unit))
     m = t["module"]
     h = t["tooth_height"]
@@ -377,7 +434,8 @@ def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: fl
         r_fs_tip=r_fs_pitch + ha,
         r_cs_tip=r_cs_pitch - ha, r_cs_pitch=r_cs_pitch, r_cs_root=r_cs_pitch + hf,
         r_cs_outer=r_cs_pitch + hf + t["cs_rim"],
-        cam_A=A, cam_B=B, cam_n=t["cam_n"],
+        cam_A=A, cam_B=B, cam_n=t["cam_n"], interference_m=float(interference_m),
+        tip_relief=float(tip_relief),
     )
 
 

@@ -40,6 +40,7 @@ import numpy as np
 from skfem import MeshTri
 
 from hdwf.drive.geometry import DriveGeometry, cs_half_space_angle, fs_half_angle
+from hdwf.drive.relief import relief_start_depth
 
 MESH_ALGORITHM = 6   # gmsh 2D: 6 = Frontal-Delaunay (quality); 5 = Delaunay
 
@@ -94,6 +95,20 @@ def _circle(geo, r: float, size: float, c: int, nseg: int | None = None) -> list
 
 def _flank_radii(r0: float, r1: float, n: int) -> np.ndarray:
     return np.linspace(r0, r1, n)
+
+
+def _relieved_radii(g: DriveGeometry, r0: float, r1: float, r_tip: float) -> np.ndarray:
+    """The flank's spline radii r0 -> r1 (12, as without relief); with tip relief also 8
+    over the relieved depth below ``r_tip``, so the spline follows the relief curve
+    (``hdwf.drive.relief``)."""
+    rr = _flank_radii(r0, r1, 12)
+    if not g.tip_relief:
+        return rr
+    d0 = min(relief_start_depth(g.module, g.addendum, g.alpha, g.tilt_factor), abs(r1 - r0))
+    toward_root = 1.0 if r_tip > min(r0, r1) else -1.0      # FS tip outside, CS tip inside
+    extra = r_tip - toward_root * np.linspace(0.0, d0, 9)
+    rr = np.unique(np.concatenate([rr, extra]))
+    return rr if r1 > r0 else rr[::-1]
 
 
 def _toothed_outline(geo, z: int, rr: np.ndarray, half_angle: np.ndarray, c: int,
@@ -168,14 +183,14 @@ def _half_circle(geo, r: float, size: float, c: int):
 
 def _fs_outline(geo, g: DriveGeometry, c: int, s: dict) -> tuple[list[int], list[int]]:
     """Outer outline of the FS: teeth centred on 2 pi i / z_FS, flanks root -> tip."""
-    rr = _flank_radii(g.r_fs_root, g.r_fs_tip, 12)
+    rr = _relieved_radii(g, g.r_fs_root, g.r_fs_tip, g.r_fs_tip)
     return _toothed_outline(geo, g.z_fs, rr, fs_half_angle(g, rr), c, s["tooth"])
 
 
 def _cs_outline(geo, g: DriveGeometry, c: int, s: dict) -> tuple[list[int], list[int]]:
     """Inner outline of the CS: spaces centred on 2 pi j / z_CS so that FS tooth 0 (angle 0)
     enters CS space 0 at the major axis; flanks tip -> root."""
-    rr = _flank_radii(g.r_cs_tip, g.r_cs_root, 12)
+    rr = _relieved_radii(g, g.r_cs_tip, g.r_cs_root, g.r_cs_tip)
     return _toothed_outline(geo, g.z_cs, rr, cs_half_space_angle(g, rr), c, s["tooth"])
 
 
@@ -325,7 +340,7 @@ def _half_geometry(geo, g: DriveGeometry, c: int, s: dict, groups: dict, cuts: l
         return l0, l1
 
     # --- FS: toothed outline 0 -> pi, bore pi -> 0
-    rr = _flank_radii(g.r_fs_root, g.r_fs_tip, 12)
+    rr = _relieved_radii(g, g.r_fs_root, g.r_fs_tip, g.r_fs_tip)
     fs_out, fs_fl, o0, o1 = _toothed_half_outline(geo, g.z_fs, rr, fs_half_angle(g, rr), c,
                                                   s["tooth"])
     fs_bore, bp = _half_circle(geo, g.r_fs_bore, s["fs_bore"], c)
@@ -334,7 +349,7 @@ def _half_geometry(geo, g: DriveGeometry, c: int, s: dict, groups: dict, cuts: l
     fs_surf = geo.addPlaneSurface([geo.addCurveLoop(loop)])
     groups.update({"fs": (2, [fs_surf]), "fs_teeth": (1, fs_out), "fs_bore": (1, fs_bore)})
     # --- CS: outer rim 0 -> pi, toothed inner outline pi -> 0
-    rr = _flank_radii(g.r_cs_tip, g.r_cs_root, 12)
+    rr = _relieved_radii(g, g.r_cs_tip, g.r_cs_root, g.r_cs_tip)
     cs_in, cs_fl, i0, i1 = _toothed_half_outline(geo, g.z_cs, rr, cs_half_space_angle(g, rr),
                                                  c, s["tooth"])
     cs_outer, op = _half_circle(geo, g.r_cs_outer, s["cs_outer"], c)

@@ -16,6 +16,8 @@ Phi = phi + phi'.  The modules, from the bottom up:
   law (frictionless or Coulomb) with its own cache and stick/slip state;
 * ``solver``: the active-set contact solver of one load level;
 * ``model``: ``LostMotionModel``, which assembles the pieces for one design;
+* ``preload``: the preload ramp that mounts preloaded teeth (``interference_m``), and the
+  check of the teeth outside the watched zones;
 * ``cycle``: the test itself, ``solve_lost_motion`` and ``solve_lost_motion_variants``.
 
 Half model (``mesh.symmetry == "half"``, hand-written): the drive and its load are

@@ -115,10 +115,11 @@ def closest_segments(xs: np.ndarray, xa: np.ndarray, xb: np.ndarray, nrm: np.nda
     kq = min(8, xa.shape[1])
     _, cand = tree.query(xs.T, k=kq)
     cand = cand.reshape(xs.shape[1], kq)
-    best = np.full(xs.shape[1], np.inf)
-    bg = np.zeros(xs.shape[1])
-    be = np.zeros(xs.shape[1], dtype=np.int64)
-    bt = np.zeros(xs.shape[1])
+    n = xs.shape[1]
+    best = np.full(n, np.inf)
+    bg, bt = np.zeros(n), np.zeros(n)
+    be = np.zeros(n, dtype=np.int64)
+    front = np.full(n, -np.inf)     # largest normal offset among the closest segments
     for jj in range(kq):
         e = cand[:, jj]
         a, b = xa[:, e], xb[:, e]
@@ -127,14 +128,18 @@ def closest_segments(xs: np.ndarray, xa: np.ndarray, xb: np.ndarray, nrm: np.nda
         t = np.clip(t_free, 0, 1)
         pr = a + t * d
         dist = np.hypot(*(xs - pr))
-        gap = ((xs - pr) * nrm[:, e]).sum(0)
-        # beyond the segment's end: in the fan outside a corner, so outside the body (inside
-        # a convex corner a point projects into an edge; the concave root corners never
-        # bear, the tip/root clearance is 0.1 h)
+        offset = ((xs - pr) * nrm[:, e]).sum(0)
+        # beyond the segment's end: the point faces a corner (the vertex), gap = distance
         beyond = (t_free < -1e-9) | (t_free > 1 + 1e-9)
-        gap = np.where(beyond, dist, gap)
-        better = dist < best - 1e-12
+        gap = np.where(beyond, dist, offset)
+        tie = np.abs(dist - best) <= 1e-12
+        better = (dist < best) & ~tie
+        front = np.where(better, offset, np.where(tie, np.maximum(front, offset), front))
         best = np.where(better, dist, best)
         bg, be, bt = (np.where(better, gap, bg), np.where(better, e, be),
                       np.where(better, t, bt))
-    return bg, be, bt
+    # ... outside the body if it lies in front of one of the two segments that meet there
+    # (the fan of a convex corner); behind both, it has sunk in at a concave vertex (the
+    # internal gear's flanks are concave polylines): a penetration of that distance
+    inside = (bg > 0) & (front < 0)
+    return np.where(inside, -bg, bg), be, bt

@@ -2,6 +2,9 @@
 
 Stage 1 pushes the wave generator into the FS (no teeth, FS rotation pinned); the cam rows
 are re-linearised at the deformed configuration until the geometry update is below 1e-6 mm.
+With a preload (``DriveGeometry.interference_m`` > 0) the teeth are then ramped in at
+zero torque (``preload.mount_preloaded``), every tooth watched.  After stage 1 the teeth
+outside the watched zones are checked for overlap (reported, ``overlap_outside_zones_um``).
 Stage 2 builds the tooth rows at the deflected configuration, frees the FS rotation and
 runs the torque sequence.  At +-T every tooth pair is re-detected at the deformed state
 (nonlinear gap); if that finds more than 0.05 um penetration (large twists slide the
@@ -29,6 +32,7 @@ from hdwf.drive.mesh import DriveMesh
 from hdwf.fe.changes import ModelChanges
 from hdwf.fe.contact_rows import ball_rows, cam_rows, fit_rows, tooth_rows
 from hdwf.fe.model import LostMotionModel
+from hdwf.fe.preload import PRELOAD_ZONE_DEG, mount_preloaded, overlap_outside_zones
 from hdwf.fe.solver import TOL_GAP, LevelSolution
 
 ZERO_TORQUE_BIAS = 1e-3  # fraction of the test torque used at the zero-torque steps
@@ -55,6 +59,7 @@ class LostMotionResult:
     n_dofs: int = 0
     wg_deflection_um: float = float("nan")   # FS bore radial displacement at major axis
     max_penetration_redetected_um: float = float("nan")  # tooth pairs re-found at +-T
+    overlap_outside_zones_um: float = float("nan")  # teeth outside the zones, at the mount
     notes: str = ""
     fields: dict | None = None   # with keep_fields: {"wg": {...}, "plus": {...}} body -> (2, n) mm
 
@@ -69,6 +74,8 @@ class _MountedWaveGenerator:
     """Stage 1 solved: the contact solution and the FS bore's radial push at the major axis."""
     solution: LevelSolution
     deflection_um: float
+    preload: dict | None = None        # the preload ramp's record (``mount_preloaded``)
+    outside_overlap_um: float = 0.0    # teeth overlapping outside the zones (unsolved)
 
 
 @dataclass(frozen=True)
@@ -178,8 +185,10 @@ def torque_fractions(steps_per_ramp: int) -> np.ndarray:
     return np.concatenate([up, up[::-1][1:], -up[1:], -up[::-1][1:]])
 
 
-def _mount_wave_generator(model: LostMotionModel) -> _MountedWaveGenerator:
-    """Stage 1: the wave generator pushed into the FS (no teeth), FS rotation pinned."""
+def _mount_wave_generator(model: LostMotionModel,
+                          ramp_teeth: bool = False) -> _MountedWaveGenerator:
+    """Stage 1: the wave generator pushed into the FS (no teeth), FS rotation pinned; with
+    ``ramp_teeth`` the teeth are then ramped in (``preload.mount_preloaded``)."""
     geom = model.geometry
     # (the half model's symmetric field has no translations: no modes in stage 1)
     model.mode_list = [] if model.half else [("fs", "tx"), ("fs", "ty"), ("ir", "tx"),
@@ -201,7 +210,15 @@ def _mount_wave_generator(model: LostMotionModel) -> _MountedWaveGenerator:
     fs = model.bodies["fs"]
     bore = fs.body_mesh.node_sets["fs_bore"]
     j0 = bore[np.argmin((fs.x[0, bore] - geom.r_fs_bore) ** 2 + fs.x[1, bore] ** 2)]
-    return _MountedWaveGenerator(state, float(u[fs.watch_index[0, j0]]) * 1000.0)
+    j0 = fs.watch_index[0, j0]          # its radial (x) entry in the watch vector
+    preload = None
+    if ramp_teeth:     # preloaded (or overlapping) teeth: ramp them in (``preload``)
+        free_deflection = float(u[j0])
+        state, preload = mount_preloaded(model, state)
+        u = state.u_watch
+        preload["wg_retreat_um"] = (free_deflection - float(u[j0])) * 1000.0
+    return _MountedWaveGenerator(state, float(u[j0]) * 1000.0, preload,
+                                 overlap_outside_zones(model, state) * 1000.0)
 
 
 def _redetect_teeth(model: LostMotionModel, torque: float,
@@ -248,8 +265,9 @@ def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWave
     """Stage 2: teeth at the deflected configuration, FS rotation free, the torque sequence."""
     geom = model.geometry
     Tn = geom.torque
-    cand = 0.25 * geom.module + 3 * (geom.r_fs + geom.r_cs)
-    model.rows["tooth"] = tooth_rows(model.structure, geom, mounted.solution.u_watch, cand)
+    if "tooth" not in model.rows:   # (a preloaded mount has its tooth rows already)
+        cand = 0.25 * geom.module + 3 * (geom.r_fs + geom.r_cs)
+        model.rows["tooth"] = tooth_rows(model.structure, geom, mounted.solution.u_watch, cand)
     model.mode_list = model.mode_list + [("fs", "rot")]
     active = mounted.solution.active
     twists, maxpen, maxpen_nl, tooth_count = [], 0.0, 0.0, 0
@@ -293,10 +311,19 @@ def _result(model: LostMotionModel, changes: ModelChanges, frac: np.ndarray,
         status="ok", reason="", solve_s=time.perf_counter() - t0,
         factorize_s=model.factorize_s, n_dofs=model.n_dofs, wg_deflection_um=mounted.deflection_um,
         max_penetration_redetected_um=max(0.0, maxpen_nl) * 1000.0,
+        overlap_outside_zones_um=mounted.outside_overlap_um,
         notes=(f"zero-torque steps at {ZERO_TORQUE_BIAS:g} T_test towards the last load; "
                f"tooth penetration re-detected at the deformed state at +-T: "
-               f"{max(0.0, maxpen_nl) * 1000:.4f} um"),
+               f"{max(0.0, maxpen_nl) * 1000:.4f} um; teeth outside the solved zones overlap by "
+               f"{mounted.outside_overlap_um:.2f} um at the mount" + _preload_note(mounted.preload)),
         fields=test.fields)
+
+
+def _preload_note(preload: dict | None) -> str:
+    if preload is None:
+        return ""
+    return (f"; preload ramp: overlap {preload['overlap_um']:.2f} um in {preload['ramp_steps']} "
+            f"steps, re-detected penetration at the mount {preload['penetration_um']:.4f} um")
 
 
 def _failed(exc: Exception, model: LostMotionModel | None, t0: float) -> LostMotionResult:
@@ -311,10 +338,18 @@ def _failed(exc: Exception, model: LostMotionModel | None, t0: float) -> LostMot
         n_dofs=model.n_dofs if model is not None else 0)
 
 
+def _zone(geom: DriveGeometry, zone_deg: float | None) -> float:
+    """The engagement zones' half width (deg): ``zone_deg``, else by whether teeth are preloaded."""
+    if zone_deg is not None:
+        return zone_deg
+    return PRELOAD_ZONE_DEG if geom.interference_m > 0 else 35.0
+
+
 def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int = 5,
                       E: float | None = None, max_iter: int = 200,
                       tol_gap: float = TOL_GAP, keep_fields: bool = False,
-                      changes: ModelChanges | None = None) -> LostMotionResult:
+                      changes: ModelChanges | None = None,
+                      zone_deg: float | None = None) -> LostMotionResult:
     """Simulate the lost-motion test 0 -> +T -> 0 -> -T -> 0 (WG locked, CS fixed).
 
     Parameters
@@ -336,6 +371,10 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
         (``wg``) and at +T (``plus``).
     changes : ModelChanges, optional
         Physical additions to the baseline model (set by ``hdwf.validation.effects``).
+    zone_deg : float, optional
+        Half width (deg) of the tooth zones about the major axis whose contacts are
+        solved; default 35 without preload, every tooth (90) with ``geom.interference_m``
+        > 0 (a preload engages teeth far beyond 35 deg).
 
     Returns
     -------
@@ -348,8 +387,11 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
     model = None
     try:
         model = LostMotionModel(geom, mesh, E=E, max_iter=max_iter, tol_gap=tol_gap,
-                                changes=changes)
-        mounted = _mount_wave_generator(model)
+                                changes=changes, zone_deg=_zone(geom, zone_deg))
+        # the ramp for a preload, and for any zones wider than today's (teeth beyond 35 deg
+        # can overlap at the mount); today's 35 deg zones keep today's path
+        ramp = geom.interference_m > 0 or zone_deg not in (None, 35.0)
+        mounted = _mount_wave_generator(model, ramp)
         fields = {"wg": model.full_displacements(mounted.solution, 0.0)} if keep_fields else None
         test = _torque_test(model, frac, mounted, fields)
         return _result(model, changes, frac, mounted, test, t0)
@@ -384,6 +426,8 @@ def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_r
     list of LostMotionResult
         One per variant, in order.
     """
+    if geom.interference_m > 0:
+        return _preloaded_variants(geom, mesh, steps_per_ramp, variants)
     t0 = time.perf_counter()
     frac = torque_fractions(steps_per_ramp)
     base = None
@@ -406,4 +450,28 @@ def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_r
             out.append(_result(model, ch, frac, mounted, test, t1))
         except Exception as exc:
             out.append(_failed(exc, model, t1))
+    return out
+
+
+def _preloaded_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int,
+                        variants: list[ModelChanges]) -> list[LostMotionResult]:
+    """Preloaded teeth are in from the mount on, and friction or the CS support change the
+    preload: each variant that changes the section mounts its own wave generator; variants
+    that differ only in series elements share that mount and torque sequence."""
+    frac = torque_fractions(steps_per_ramp)
+    out, solved = [], {}
+    for ch in variants:
+        t1 = time.perf_counter()
+        key = ch.fe_part()
+        if key not in solved:
+            model = None
+            try:
+                model = LostMotionModel(geom, mesh, changes=key, zone_deg=_zone(geom, None))
+                mounted = _mount_wave_generator(model, True)
+                solved[key] = (model, mounted, _torque_test(model, frac, mounted, None), None)
+            except Exception as exc:   # any failure is reported, never a silent number
+                solved[key] = (model, None, None, exc)
+        model, mounted, test, exc = solved[key]
+        out.append(_failed(exc, model, t1) if exc is not None
+                   else _result(model, ch, frac, mounted, test, t1))
     return out

@@ -118,12 +118,19 @@ class WorkingSet:
     def refresh(self, structure: Structure, rows: dict[str, Rows],
                 kind: str) -> RefreshedPairs | None:
         """Renew the columns of the pairs of ``kind`` after a new linearisation of its rows
-        (same count); None if none of them is in the working set."""
+        (same count); None if none of them is in the working set or none of their rows
+        changed.  Only pairs whose row changed are back-substituted (the others' columns
+        are the same numbers), which keeps the preload ramp's re-linearisations cheap."""
         idx = [(self.position[(k, i)], i) for (k, i) in self.pairs if k == kind]
         if not idx:
             return None
         pos = np.array([a for a, _ in idx])
         row_indices = [b for _, b in idx]
+        delta = abs(rows[kind].G[row_indices] - self.normal_rows[pos]).max(axis=1).toarray().ravel()
+        changed = np.flatnonzero(delta > 0)
+        if changed.size == 0:
+            return None
+        pos, row_indices = pos[changed], [row_indices[j] for j in changed]
         X, Xq = structure.compliance_columns(rows[kind].G[row_indices])
         self._column_store[:, pos] = X
         self.twist_columns[pos] = Xq
