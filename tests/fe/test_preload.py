@@ -58,6 +58,7 @@ def _major_axis_gap(model, g, shift):
     return float((rows.g0 + rows.G @ u)[j])
 
 
+@pytest.mark.slow
 def test_rigid_wedge_offset_delta_needs_radial_motion_delta_over_sin_alpha():
     """A rigid wedge: the major-axis FS tooth pushed out rigidly by w0 = m sits in its CS
     space overlapping it by the interference delta at the pitch point (both involutes
@@ -103,6 +104,7 @@ def _tooth_force(model, mounted, g):
     return total, magnitude
 
 
+@pytest.mark.slow
 def test_preloaded_wedge_force_balance_and_true_gap():
     """The mounted preloaded drive (0.1 m): no tooth pair re-detected at its true gap
     penetrates more than 0.06 um; the major-axis tooth is a balanced wedge: its two flanks
@@ -133,7 +135,8 @@ def test_preload_ramp_converges_to_the_same_state(monkeypatch):
     assert a.deflection_um == pytest.approx(b.deflection_um, abs=preload.GEO_TOL * 1000)
 
 
-@pytest.mark.parametrize("interference_m", [pytest.param(0.1, marks=pytest.mark.slow), 0.3])
+@pytest.mark.slow
+@pytest.mark.parametrize("interference_m", [0.1, 0.3])
 def test_preloaded_lost_motion_solves_and_is_small(interference_m):
     """Up to 0.3 m the test solves (status ok) with the true gap re-detected at +-T, and the
     preloaded drive has far less lost motion than the same design without preload."""
@@ -173,6 +176,7 @@ def test_preloaded_half_model_equals_full_model():
     assert half.wg_deflection_um == pytest.approx(full.wg_deflection_um, abs=0.05)
 
 
+@pytest.mark.slow
 def test_preloaded_variants_share_a_mount_only_across_series_elements():
     """With a preload, variants that differ only in series elements (the output play here)
     share one mount and torque sequence: the same rim twist, the play added on the output;

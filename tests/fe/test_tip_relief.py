@@ -94,6 +94,7 @@ def _exit_overlap_um(unit, relief):
     return _mount_wave_generator(model).outside_overlap_um
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("unit", ["hd42", "hd120"])
 def test_exit_zone_is_clear_at_the_nominal_design(unit):
     """Mounted nominal design (zero offsets, zero interference, w0 = m), coarse mesh: the
