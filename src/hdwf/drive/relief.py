@@ -44,6 +44,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.optimize import brentq
 
 
 def _advance(two_phi, kappa):
@@ -86,9 +87,7 @@ def tip_relief(depth, module: float, addendum: float, alpha: float, kappa: float
 def relief_start_depth(module: float, addendum: float, alpha: float,
                        kappa: float = 1.0) -> float:
     """Depth below the tip (mm) where the relief starts (e = 0 on the path); 0 if none."""
-    lo, hi = math.pi / 3, math.pi           # the exit root (e < 0 at 60 deg of 2 phi)
-    f = lambda t: _advance(t, kappa) - math.tan(alpha) * (1.0 - math.cos(t))
-    for _ in range(100):                    # bisection: f < 0 below its root, > 0 above
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if f(mid) < 0 else (lo, mid)
-    return max(0.0, 2.0 * addendum - module * (1.0 - math.cos(lo)))
+    # the exit root of e in 2 phi: e < 0 at 60 deg, > 0 at 180 deg
+    two_phi = brentq(lambda t: _advance(t, kappa) - math.tan(alpha) * (1.0 - math.cos(t)),
+                     math.pi / 3, math.pi, xtol=1e-15)
+    return max(0.0, 2.0 * addendum - module * (1.0 - math.cos(two_phi)))

@@ -31,7 +31,7 @@ from hdwf.drive.geometry import ARCMIN, DriveGeometry
 from hdwf.drive.mesh import DriveMesh
 from hdwf.fe.changes import ModelChanges
 from hdwf.fe.contact_rows import ball_rows, cam_rows, fit_rows, tooth_rows
-from hdwf.fe.model import LostMotionModel
+from hdwf.fe.model import ZONE_DEG, LostMotionModel
 from hdwf.fe.preload import PRELOAD_ZONE_DEG, mount_preloaded, overlap_outside_zones
 from hdwf.fe.solver import TOL_GAP, LevelSolution
 
@@ -342,7 +342,7 @@ def _zone(geom: DriveGeometry, zone_deg: float | None) -> float:
     """The engagement zones' half width (deg): ``zone_deg``, else by whether teeth are preloaded."""
     if zone_deg is not None:
         return zone_deg
-    return PRELOAD_ZONE_DEG if geom.interference_m > 0 else 35.0
+    return PRELOAD_ZONE_DEG if geom.interference_m > 0 else ZONE_DEG
 
 
 def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int = 5,
@@ -390,7 +390,7 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
                                 changes=changes, zone_deg=_zone(geom, zone_deg))
         # the ramp for a preload, and for any zones wider than today's (teeth beyond 35 deg
         # can overlap at the mount); today's 35 deg zones keep today's path
-        ramp = geom.interference_m > 0 or zone_deg not in (None, 35.0)
+        ramp = geom.interference_m > 0 or zone_deg not in (None, ZONE_DEG)
         mounted = _mount_wave_generator(model, ramp)
         fields = {"wg": model.full_displacements(mounted.solution, 0.0)} if keep_fields else None
         test = _torque_test(model, frac, mounted, fields)

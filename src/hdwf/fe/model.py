@@ -26,6 +26,9 @@ from hdwf.fe.structure import ModeName, Structure
 from hdwf.fe.working_set import WorkingSet
 
 
+ZONE_DEG = 35.0   # half width (deg) of the tooth zones about the major axes solved by default
+
+
 def _in_engagement_zones(bm: BodyMesh, nodes: np.ndarray, zone_deg: float) -> np.ndarray:
     """The ``nodes`` within ``zone_deg`` of either major axis (where the teeth engage)."""
     th = np.arctan2(bm.mesh.p[1, nodes], bm.mesh.p[0, nodes])
@@ -55,7 +58,7 @@ class LostMotionModel:
     """
 
     def __init__(self, geom: DriveGeometry, mesh: DriveMesh, E: float | None = None,
-                 max_iter: int = 200, tol_gap: float = TOL_GAP, zone_deg: float = 35.0,
+                 max_iter: int = 200, tol_gap: float = TOL_GAP, zone_deg: float = ZONE_DEG,
                  n_bins: int = 360, changes: ModelChanges | None = None):
         self.geometry = geom
         self.changes = ModelChanges() if changes is None else changes
