@@ -25,7 +25,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from hdwf.fe.contact_rows import PairId, Rows, slip_rows_of, stack_slip_rows
-from hdwf.fe.working_set import AddedPairs, RefreshedPairs, WorkingSet, grow_column_store
+from hdwf.fe.working_set import AddedPairs, ColumnStore, RefreshedPairs, WorkingSet
 from hdwf.fe.structure import Structure
 
 FRICTION_MAX_IT = 30     # slip-direction iterations per load level (flank friction)
@@ -142,7 +142,7 @@ class FlankFriction:
         self.mu = float(mu)
         self.nwatch = nwatch
         n = n_pairs
-        self._column_store = np.zeros((nwatch, n))     # K^-1 Gt^T of the working set
+        self.store = ColumnStore(nwatch, n)            # K^-1 Gt^T of the working set
         self.twist_columns = np.zeros(n)               # q^T K^-1 Gt^T
         self.normal_slip = np.zeros((n, n))            # G_W K^-1 Gt_W^T
         self.slip_slip = np.zeros((n, n))              # Gt_W K^-1 Gt_W^T
@@ -156,11 +156,11 @@ class FlankFriction:
 
     @property
     def columns(self) -> np.ndarray:
-        return self._column_store[:, :self.size]
+        return self.store.columns
 
     def copy(self) -> "FlankFriction":
         new = FlankFriction(self.mu, self.nwatch)
-        new._column_store = self._column_store.copy()
+        new.store = self.store.copy()
         new.twist_columns = self.twist_columns.copy()
         new.normal_slip = self.normal_slip.copy()
         new.slip_slip = self.slip_slip.copy()
@@ -174,19 +174,18 @@ class FlankFriction:
         n0, k = added.first, len(added.ids)
         Tn = slip_rows_of(rows, added.ids, self.nwatch)
         Y, Yq = structure.compliance_columns(Tn)
-        self._column_store = grow_column_store(self._column_store, n0, k)
-        self._column_store[:, n0:n0 + k] = Y
+        self.store.append(Y)
         self.twist_columns = np.concatenate([self.twist_columns, Yq])
         self.slip_rows = Tn if self.slip_rows is None else sp.vstack([self.slip_rows, Tn]).tocsr()
         CWY = np.zeros((n0 + k, n0 + k))      # the slip columns are not symmetric
         CWY[:n0, :n0] = self.normal_slip
         CWY[:, n0:] = np.asarray(working_set.normal_rows @ Y)
-        CWY[n0:, :n0] = np.asarray(added.normal_rows @ self._column_store[:, :n0])
+        CWY[n0:, :n0] = self.store.project(added.normal_rows, n0)
         self.normal_slip = CWY
         CWYY = np.zeros((n0 + k, n0 + k))
         CWYY[:n0, :n0] = self.slip_slip
         CWYY[:, n0:] = np.asarray(self.slip_rows @ Y)
-        CWYY[n0:, :n0] = np.asarray(Tn @ self._column_store[:, :n0])
+        CWYY[n0:, :n0] = self.store.project(Tn, n0)
         self.slip_slip = CWYY
 
     def pairs_refreshed(self, structure: Structure, rows: dict[str, Rows],
@@ -194,11 +193,11 @@ class FlankFriction:
         """Renew the slip columns of pairs whose rows were re-linearised."""
         Y, Yq = structure.compliance_columns(
             slip_rows_of(rows, [(refreshed.kind, b) for b in refreshed.row_indices], self.nwatch))
-        self._column_store[:, refreshed.positions] = Y
+        self.store.replace(refreshed.positions, Y)
         self.twist_columns[refreshed.positions] = Yq
-        self.normal_slip = np.asarray(working_set.normal_rows @ self.columns)
+        self.normal_slip = self.store.project(working_set.normal_rows)
         self.slip_rows = slip_rows_of(rows, working_set.pairs, self.nwatch)
-        self.slip_slip = np.asarray(self.slip_rows @ self.columns)
+        self.slip_slip = self.store.project(self.slip_rows)
 
     def start_level(self, rows: dict[str, Rows], ids: list[PairId], R: np.ndarray,
                     u_start: np.ndarray, unit_torque_u_watch: np.ndarray) -> "FrictionLevel":
@@ -303,9 +302,7 @@ class FrictionLevel:
         nA, nS = len(block.pairs), system.n_tangential
         ftA = system.slide_factor * solution[:nA]
         ftA[system.sticking] = solution[nA:nA + nS]
-        fW = np.zeros(self.friction.size)
-        fW[block.positions] = ftA
-        u = u + self.friction.columns @ fW
+        u = u + self.friction.store.combine(block.positions, ftA)
         ft_full = np.zeros(block.n_pairs)
         ft_full[block.rows] = ftA
         return u, ft_full

@@ -304,10 +304,8 @@ class ContactSolver:
         except np.linalg.LinAlgError:
             sol = np.linalg.lstsq(M, system.rhs, rcond=None)[0]
         pA, alpha = sol[:nA], sol[nA + nS:]
-        pW = np.zeros(len(self.working_set.pairs))
-        pW[block.positions] = pA
-        u = (problem.torque * problem.structure.unit_torque_u_watch + self.working_set.columns @ pW
-             + problem.modes.watch @ alpha)
+        u = (problem.torque * problem.structure.unit_torque_u_watch
+             + self.working_set.store.combine(block.positions, pA) + problem.modes.watch @ alpha)
         u, ft_full = level.tangential(system, sol, block, u)
         p_full = np.zeros(block.n_pairs)
         p_full[block.rows] = pA

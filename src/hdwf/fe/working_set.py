@@ -18,27 +18,61 @@ from hdwf.fe.contact_rows import PairId, Rows
 from hdwf.fe.structure import Structure
 
 
-def grow_column_store(buf: np.ndarray, n0: int, k: int) -> np.ndarray:
-    """``buf`` with room for ``k`` more columns after its first ``n0`` (grown geometrically).
+class ColumnStore:
+    """Columns K^-1 G^T (nwatch long) by working-set position, stored one per row.
+
+    A PDAS iterate combines only the columns of its active pairs (a fifth of the working set,
+    typically); with a column per contiguous row that product reads just those rows, about ten
+    times faster than multiplying the whole store by a mostly zero vector.
 
     Parameters
     ----------
-    buf : numpy.ndarray
-        (nwatch, capacity) column store; its first ``n0`` columns are in use.
-    n0, k : int
-        Columns in use and columns to add.
-
-    Returns
-    -------
-    numpy.ndarray
-        ``buf`` itself if it has room, else a larger copy.
+    nwatch : int
+        Length of the watch vector.
+    n : int
+        Columns in use from the start (zero).
     """
-    if n0 + k <= buf.shape[1]:
-        return buf
-    cap = max(2 * buf.shape[1], n0 + k, 256)
-    new = np.zeros((buf.shape[0], cap))
-    new[:, :n0] = buf[:, :n0]
-    return new
+
+    def __init__(self, nwatch: int, n: int = 0):
+        self._rows = np.zeros((n, nwatch))
+        self.size = n
+
+    def copy(self) -> "ColumnStore":
+        new = ColumnStore(self._rows.shape[1])
+        new._rows, new.size = self._rows.copy(), self.size
+        return new
+
+    @property
+    def columns(self) -> np.ndarray:
+        """The columns in use (nwatch x size; a view)."""
+        return self._rows[:self.size].T
+
+    def append(self, X: np.ndarray):
+        """Add the columns X (nwatch x k) after the last one (storage grown geometrically)."""
+        n0, k = self.size, X.shape[1]
+        if n0 + k > self._rows.shape[0]:
+            grown = np.zeros((max(2 * self._rows.shape[0], n0 + k, 256), self._rows.shape[1]))
+            grown[:n0] = self._rows[:n0]
+            self._rows = grown
+        self._rows[n0:n0 + k] = X.T
+        self.size = n0 + k
+
+    def replace(self, positions: np.ndarray, X: np.ndarray):
+        """Renew the columns at ``positions`` with X (nwatch x len(positions))."""
+        self._rows[positions] = X.T
+
+    def combine(self, positions: np.ndarray, weights: np.ndarray) -> np.ndarray:
+        """sum_k weights[k] * column[positions[k]] (nwatch)."""
+        return weights @ self._rows[positions]
+
+    def project(self, G: sp.csr_matrix, n: int | None = None) -> np.ndarray:
+        """G @ columns[:, :n] (rows x n) for sparse rows G, reading only the watch entries G
+        touches (a contact row has a handful) instead of copying the whole store."""
+        n = self.size if n is None else n
+        G = sp.csr_matrix(G)
+        touched = self._rows[:n][:, G.indices]               # n x nnz(G)
+        per_entry = sp.csr_matrix((G.data, np.arange(G.nnz), G.indptr), shape=(G.shape[0], G.nnz))
+        return np.asarray(per_entry @ np.ascontiguousarray(touched.T))
 
 
 @dataclass(frozen=True)
@@ -69,7 +103,7 @@ class WorkingSet:
     def __init__(self, nwatch: int):
         self.pairs: list[PairId] = []
         self.position: dict[PairId, int] = {}
-        self._column_store = np.zeros((nwatch, 0))  # K^-1 G^T on the watch dofs, by position
+        self.store = ColumnStore(nwatch)            # K^-1 G^T on the watch dofs, by position
         self.twist_columns = np.zeros(0)            # q^T K^-1 G^T
         self.normal_rows: sp.csr_matrix | None = None   # G of the pairs, by position
         self.compliance = np.zeros((0, 0))          # G K^-1 G^T among the pairs
@@ -78,7 +112,7 @@ class WorkingSet:
         """An independent copy (the rows matrix is never changed in place, so it is shared)."""
         new = WorkingSet(0)
         new.pairs, new.position = list(self.pairs), dict(self.position)
-        new._column_store = self._column_store.copy()
+        new.store = self.store.copy()
         new.twist_columns = self.twist_columns.copy()
         new.normal_rows = self.normal_rows
         new.compliance = self.compliance.copy()
@@ -87,7 +121,7 @@ class WorkingSet:
     @property
     def columns(self) -> np.ndarray:
         """Compliance columns K^-1 G^T (nwatch x pairs) of the working set."""
-        return self._column_store[:, :len(self.pairs)]
+        return self.store.columns
 
     def add(self, structure: Structure, rows: dict[str, Rows],
             ids: list[PairId]) -> AddedPairs | None:
@@ -98,8 +132,7 @@ class WorkingSet:
         Gn = sp.vstack([rows[k].G[i] for k, i in ids]).tocsr()
         X, Xq = structure.compliance_columns(Gn)
         n0, k = len(self.pairs), len(ids)
-        self._column_store = grow_column_store(self._column_store, n0, k)
-        self._column_store[:, n0:n0 + k] = X
+        self.store.append(X)
         for i in ids:
             self.position[i] = len(self.pairs)
             self.pairs.append(i)
@@ -132,8 +165,8 @@ class WorkingSet:
             return None
         pos, row_indices = pos[changed], [row_indices[j] for j in changed]
         X, Xq = structure.compliance_columns(rows[kind].G[row_indices])
-        self._column_store[:, pos] = X
+        self.store.replace(pos, X)
         self.twist_columns[pos] = Xq
         self.normal_rows = sp.vstack([rows[k].G[i] for k, i in self.pairs]).tocsr()
-        self.compliance = np.asarray(self.normal_rows @ self.columns)
+        self.compliance = self.store.project(self.normal_rows)
         return RefreshedPairs(kind, pos, row_indices)
