@@ -57,8 +57,8 @@ from hdwf.fe.solver import ContactFailure
 # torques first sampled on each slice's curve, as multiples of the test torque (each side);
 # a slice that has to carry more is sampled further out (twice its largest) when needed
 SAMPLE_FRACTIONS = (ZERO_TORQUE_BIAS, 0.25, 0.5, 1.0, 2.0)
-THETA_TOL = 2e-3 * ARCMIN   # rad: slice twists at the combined solution agree to this (the
-                            # contact tolerance, 0.01 um over r_b ~ 20 mm, is 1.7e-3 arcmin)
+THETA_TOL = 5e-3 * ARCMIN   # rad: slice twists at the combined solution agree to this (about 3x
+                            # the contact tolerance: 0.01 um over r_b ~ 20 mm is 1.7e-3 arcmin)
 MAX_REFINE = 12             # refinement rounds per torque
 
 
