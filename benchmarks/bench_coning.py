@@ -9,7 +9,8 @@ appended to ``--out``: status (a failed slice fails the case: no number), Phi, t
 Phi, the level solves of its slices, and the seconds of that design and interference (shared
 by its cases).  The summary prints, per (interference, c, N): ok count, Phi range, median
 ratio ours/paper, Spearman, R², dPhi/dr_FS by least squares over the five inputs (the
-paper's on the same designs).
+paper's on the same designs) and the rms of log(ours/paper), the calibration objective
+(level and spread at once).
 
   OMP_NUM_THREADS=1 python benchmarks/bench_coning.py --unit hd42 --sets 1-27 \\
       --interference 0.13,0.145 --coning 0.2,0.4 --slices 4 --out coning_hd42.csv
@@ -85,9 +86,11 @@ def summary(out: Path):
         r2 = np.corrcoef(ok.phi, ok.phi_paper)[0, 1] ** 2
         slope = _slope(table, ok.set.to_numpy(), ok.phi.to_numpy())
         paper = _slope(table, ok.set.to_numpy(), ok.phi_paper.to_numpy())
+        rms = float(np.sqrt(np.mean(np.log(ok.phi / ok.phi_paper) ** 2)))
         per_design = ok.drop_duplicates("set").design_solve_s
         print(f"{unit} δ={im:.3f} m c={c:g} N={n}: {len(ok)}/{len(d)} ok, Φ {ok.phi.min():.3f}–"
-              f"{ok.phi.max():.3f}, median ratio {ratio:.3f}, Spearman {rho:.3f}, R² {r2:.3f}, "
+              f"{ok.phi.max():.3f}, median ratio {ratio:.3f}, rms log ratio {rms:.3f}, "
+              f"Spearman {rho:.3f}, R² {r2:.3f}, "
               f"dΦ/dr_FS {slope:.4f} ({paper:.4f}) arcmin/µm, design solve median "
               f"{per_design.median():.1f} s")
 
