@@ -14,7 +14,13 @@ repeat until no pair has p < 0 and the largest penetration of all candidate pair
 < ``tol_gap`` (1e-5 mm = 0.01 um).  Candidates outside the working set are checked every
 iteration with the displacement on the contact DOFs, so no violated pair can be missed.
 A free rigid mode that is loaded but not yet held (the FS rotation under torque while the
-teeth are apart) is closed by adding the first pair that closes along that mode.
+teeth are apart) is closed by adding the first pair that closes along that mode.  A mode
+held only weakly (e.g. by two near-radial tip contacts of a relieved, lightly preloaded
+section) makes the iterate swing it far (radians) and penetrate hundreds of pairs by
+millimetres, far outside the linearised rows; such an iterate (a loaded free mode and a
+pair that was open at the current point penetrated by more than ``max_overshoot``) is not
+taken: as in a primal active-set method the step stops where the first open pair closes
+(ratio test), that pair enters the active set and nothing is dropped.
 Around the PDAS, the Hertz secants s_ball of the balls are iterated to 0.1 % of the ball
 loads, and with flank friction the stick/slip states of the tooth pairs (``friction``).
 Cost: one factorisation per body plus back-solves, a handful of dense KKT solves per
@@ -49,11 +55,16 @@ class SolverSettings:
 
     ``add_min`` and ``add_frac``: violated pairs added per iteration, the most violated
     first (full switching cycles when a near-mechanism makes one iterate overshoot).
+    ``max_overshoot``: with a loaded free rigid mode, an iterate that penetrates a pair
+    open at the current point by more than this is replaced by a ratio-test step to the
+    first closing pair (see the module docstring); infinite = never.
     """
     max_iter: int = 200          # active-set iterations per PDAS solve
     tol_gap: float = TOL_GAP     # mm: largest penetration accepted
     add_min: int = 5
     add_frac: float = 0.2
+    max_overshoot: float = np.inf   # mm: a loaded-mode iterate penetrating an open pair by
+                                    # more is cut back to the first closing pair (ratio test)
 
 
 @dataclass(frozen=True)
@@ -231,6 +242,9 @@ class ContactSolver:
         sdiag[problem.ball_index] = s_ball
         Guq = problem.G @ problem.structure.unit_torque_u_watch
         A = set(act)
+        # gaps at the current point of the step (a ratio-test step moves it; see _cut_back)
+        gap_at = problem.free_gap.copy()
+        loaded = bool(np.any(np.abs(problem.torque * problem.modes.load) > 1e-12))
         for it in range(self.settings.max_iter):
             self.iterations += 1
             self.enter(problem.structure, problem.rows, sorted(A - set(self.working_set.position)))
@@ -247,11 +261,36 @@ class ContactSolver:
             viol = viol[:max(self.settings.add_min, int(self.settings.add_frac * len(viol)))]
             if not neg and not viol:
                 return _ActiveSetOutcome(np.maximum(p_full, 0.0), ft_full, alpha, u, gap, True)
+            if loaded:
+                cut = self._cut_back(problem, gap_at, gap)
+                if cut is not None:      # overshoot: step to the first closing pair(s)
+                    gap_at, closing = cut
+                    A.update(closing)
+                    continue
             if it > 25 and neg:          # anti-cycling: one change at a time
                 neg = [block.pairs[int(np.argmin(pA))]]
             A.difference_update(neg)
             A.update(viol)
         return _ActiveSetOutcome(p_full, ft_full, alpha, u, gap, False)
+
+    def _cut_back(self, problem: _LevelProblem, gap_at: np.ndarray,
+                  gap: np.ndarray) -> tuple[np.ndarray, list[PairId]] | None:
+        """Ratio test of an overshooting iterate (primal active-set step).
+
+        The gaps are linear along the path from the current point (``gap_at``) to the
+        iterate (``gap``).  If a pair open at the current point is penetrated by more than
+        ``max_overshoot`` at the iterate, the step is cut back to t*, where the first open
+        pair closes; returns the gaps at t* and the pairs closing there (to 1e-9 of t*).
+        None if the iterate does not overshoot (or nothing closes along the step)."""
+        tol = self.settings.tol_gap
+        opened = gap_at > -tol
+        if not opened.any() or -gap[opened].min() <= self.settings.max_overshoot:
+            return None
+        closing = np.flatnonzero(opened & (gap < -tol))
+        t = np.maximum(gap_at[closing], 0.0) / (gap_at[closing] - gap[closing])
+        tstar = float(t.min())
+        first = closing[t <= tstar * (1.0 + 1e-9) + 1e-15]
+        return gap_at + tstar * (gap - gap_at), [problem.ids[j] for j in first]
 
     def _hold_loaded_modes(self, problem: _LevelProblem, A: set[PairId]):
         """A loaded rigid mode with nothing holding it: add the first pair it closes."""
