@@ -14,7 +14,7 @@ from hdwf.drive.geometry import drive_geometry, fs_half_angle, geometric_backlas
 from hdwf.drive.mesh import build_mesh
 from hdwf.fe import LostMotionModel, preload, solve_lost_motion
 from hdwf.fe.contact_rows import stack_rows, tooth_rows
-from hdwf.fe.cycle import _mount_wave_generator
+from hdwf.fe.cycle import mount_wave_generator
 
 COARSE = {"elements_over_height": 5, "elements_over_thickness": 3}
 NOMINAL = ("hd42", 31.0, 42.0, 0.015, 0.0, 0.0)      # Table 3 nominal: zero offsets
@@ -86,7 +86,7 @@ def _mounted(interference_m, ramp_step_m=None, monkeypatch=None):
     if ramp_step_m is not None:
         monkeypatch.setattr(preload, "RAMP_STEP_M", ramp_step_m)
     model = LostMotionModel(g, build_mesh(g, **COARSE, symmetry="half"), zone_deg=90.0)
-    return g, model, _mount_wave_generator(model, ramp_teeth=True)
+    return g, model, mount_wave_generator(model, ramp_teeth=True)
 
 
 def _tooth_force(model, mounted, g):

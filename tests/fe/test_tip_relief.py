@@ -14,7 +14,7 @@ from hdwf.drive.geometry import cs_half_space_angle, drive_geometry, fs_half_ang
 from hdwf.drive.mesh import build_mesh
 from hdwf.drive.relief import relief_start_depth, tip_relief
 from hdwf.fe import LostMotionModel
-from hdwf.fe.cycle import _mount_wave_generator
+from hdwf.fe.cycle import mount_wave_generator
 
 COARSE = {"elements_over_height": 5, "elements_over_thickness": 3, "symmetry": "half"}
 NOMINAL = {"hd42": (31.0, 42.0, 0.015, 0.0, 0.0), "hd120": (90.0, 120.0, 0.030, 0.0, 0.0)}
@@ -91,7 +91,7 @@ def test_meshed_outline_follows_the_relief():
 def _exit_overlap_um(unit, relief):
     g = drive_geometry(unit, *NOMINAL[unit], tip_relief=relief)
     model = LostMotionModel(g, build_mesh(g, **COARSE))
-    return _mount_wave_generator(model).outside_overlap_um
+    return mount_wave_generator(model).outside_overlap_um
 
 
 @pytest.mark.slow

@@ -25,7 +25,7 @@ T = (1/N) sum_j T'_j(theta), T'_j the full section's torque-twist relation at pu
 Why combining curves is exact for our Phi.  ``cycle`` defines Phi = theta(+T) - theta(-T)
 (the twists at +-T minus the first state's, which cancels).  Frictionless contact is
 elastic and path independent: the state at a torque does not depend on the levels before
-it (up to the re-linearisation of the tooth rows at a state, ``cycle._redetect_teeth``).
+it (up to the re-linearisation of the tooth rows at a state, ``cycle.redetect_teeth``).
 So theta(+-T) of the slices in parallel is found from each slice's twist-torque relation
 alone: sample it, invert the summed monotone relation mean_j T'_j(theta) = +-T, then solve
 every slice at its share T'_j* and insert that point (``refine``) until every slice's
@@ -49,7 +49,7 @@ import numpy as np
 
 from hdwf.drive.geometry import ARCMIN, DriveGeometry, size_cam
 from hdwf.drive.mesh import DriveMesh
-from hdwf.fe.cycle import ZERO_TORQUE_BIAS, _mount_wave_generator, _redetect_teeth
+from hdwf.fe.cycle import ZERO_TORQUE_BIAS, mount_wave_generator, redetect_teeth
 from hdwf.fe.model import LostMotionModel
 from hdwf.fe.preload import PRELOAD_ZONE_DEG
 from hdwf.fe.solver import ContactFailure
@@ -89,7 +89,7 @@ class SliceCurve:
         side = 1 if torque > 0 else -1
         model, active = self.models[side]
         level = model.solve_level(torque, active)
-        level, _ = _redetect_teeth(model, torque, level)
+        level, _ = redetect_teeth(model, torque, level)
         self.models[side][1] = level.active
         self.torque.append(float(torque))
         self.twist.append(float(level.twist))
@@ -110,7 +110,7 @@ def build_slice(base: LostMotionModel, geom: DriveGeometry, push: float) -> Slic
     with the teeth ramped in, free the FS rotation and sample the curve on both sides."""
     model = base.fork()
     model.geometry = coned_geometry(geom, push)
-    mounted = _mount_wave_generator(model, True)
+    mounted = mount_wave_generator(model, True)
     model.mode_list = model.mode_list + [("fs", "rot")]
     curve = SliceCurve(push)
     for side in (1, -1):

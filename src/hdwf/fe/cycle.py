@@ -185,7 +185,7 @@ def torque_fractions(steps_per_ramp: int) -> np.ndarray:
     return np.concatenate([up, up[::-1][1:], -up[1:], -up[::-1][1:]])
 
 
-def _mount_wave_generator(model: LostMotionModel,
+def mount_wave_generator(model: LostMotionModel,
                           ramp_teeth: bool = False) -> _MountedWaveGenerator:
     """Stage 1: the wave generator pushed into the FS (no teeth), FS rotation pinned; with
     ``ramp_teeth`` the teeth are then ramped in (``preload.mount_preloaded``)."""
@@ -221,7 +221,7 @@ def _mount_wave_generator(model: LostMotionModel,
                                  overlap_outside_zones(model, state) * 1000.0)
 
 
-def _redetect_teeth(model: LostMotionModel, torque: float,
+def redetect_teeth(model: LostMotionModel, torque: float,
                     level: LevelSolution) -> tuple[LevelSolution, float]:
     """Independent check at +-T: re-detect every FS/CS pair in the zones at the deformed
     configuration (nonlinear gap, no candidate threshold).  Large twists slide the flanks
@@ -280,7 +280,7 @@ def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWave
             T = ZERO_TORQUE_BIAS * Tn * last_sign
         level = model.solve_level(T, active)
         if abs(abs(fraction) - 1.0) < 1e-12:
-            level, pen_nl = _redetect_teeth(model, T, level)
+            level, pen_nl = redetect_teeth(model, T, level)
             maxpen_nl = max(maxpen_nl, pen_nl)
         active = level.active
         twists.append(level.twist)
@@ -391,7 +391,7 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
         # the ramp for a preload, and for any zones wider than today's (teeth beyond 35 deg
         # can overlap at the mount); today's 35 deg zones keep today's path
         ramp = geom.interference_m > 0 or zone_deg not in (None, ZONE_DEG)
-        mounted = _mount_wave_generator(model, ramp)
+        mounted = mount_wave_generator(model, ramp)
         fields = {"wg": model.full_displacements(mounted.solution, 0.0)} if keep_fields else None
         test = _torque_test(model, frac, mounted, fields)
         return _result(model, changes, frac, mounted, test, t0)
@@ -433,7 +433,7 @@ def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_r
     base = None
     try:
         base = LostMotionModel(geom, mesh)
-        mounted = _mount_wave_generator(base)
+        mounted = mount_wave_generator(base)
     except Exception as exc:
         failed = _failed(exc, base, t0)
         return [failed for _ in variants]
@@ -467,7 +467,7 @@ def _preloaded_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: in
             model = None
             try:
                 model = LostMotionModel(geom, mesh, changes=key, zone_deg=_zone(geom, None))
-                mounted = _mount_wave_generator(model, True)
+                mounted = mount_wave_generator(model, True)
                 solved[key] = (model, mounted, _torque_test(model, frac, mounted, None), None)
             except Exception as exc:   # any failure is reported, never a silent number
                 solved[key] = (model, None, None, exc)

@@ -72,7 +72,7 @@ def _settle(model: LostMotionModel, nodes: tuple, hold: float, level: LevelSolut
     Only the gaps are moved to the re-detected ones (no back-substitution) as long as that
     halves the error; when it stops doing so the pairs near contact are re-linearised (new
     normals and segments, new columns).  The torque stage re-linearises the loaded pairs
-    again at +-T (``cycle._redetect_teeth``)."""
+    again at +-T (``cycle.redetect_teeth``)."""
     st, geom = model.structure, model.geometry
     err, prev = math.inf, math.inf
     for _ in range(GEO_MAX_IT):
