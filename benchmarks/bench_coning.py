@@ -35,9 +35,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import numpy as np
 import pandas as pd
-from scipy.stats import spearmanr
 
-from bench_preload import COLUMNS, ROOT, TABLES, _sets, _slope
+from bench_preload import COLUMNS, ROOT, TABLES, _sets, agreement
 from hdwf.drive.geometry import drive_geometry
 from hdwf.drive.mesh import build_mesh
 from hdwf.fe.coning import solve_coned
@@ -81,17 +80,13 @@ def summary(out: Path):
         if len(ok) < 3:
             print(f"{unit} δ={im:.3f} c={c:g} N={n}: {len(ok)}/{len(d)} ok")
             continue
-        ratio = np.median(ok.phi / ok.phi_paper)
-        rho = spearmanr(ok.phi, ok.phi_paper)[0]
-        r2 = np.corrcoef(ok.phi, ok.phi_paper)[0, 1] ** 2
-        slope = _slope(table, ok.set.to_numpy(), ok.phi.to_numpy())
-        paper = _slope(table, ok.set.to_numpy(), ok.phi_paper.to_numpy())
+        a = agreement(table, ok)
         rms = float(np.sqrt(np.mean(np.log(ok.phi / ok.phi_paper) ** 2)))
         per_design = ok.drop_duplicates("set").design_solve_s
         print(f"{unit} δ={im:.3f} m c={c:g} N={n}: {len(ok)}/{len(d)} ok, Φ {ok.phi.min():.3f}–"
-              f"{ok.phi.max():.3f}, median ratio {ratio:.3f}, rms log ratio {rms:.3f}, "
-              f"Spearman {rho:.3f}, R² {r2:.3f}, "
-              f"dΦ/dr_FS {slope:.4f} ({paper:.4f}) arcmin/µm, design solve median "
+              f"{ok.phi.max():.3f}, median ratio {a['ratio']:.3f}, rms log ratio {rms:.3f}, "
+              f"Spearman {a['rho']:.3f}, R² {a['r2']:.3f}, "
+              f"dΦ/dr_FS {a['slope']:.4f} ({a['paper_slope']:.4f}) arcmin/µm, design solve median "
               f"{per_design.median():.1f} s")
 
 

@@ -93,6 +93,17 @@ def _slope(table: pd.DataFrame, sets, phi: np.ndarray) -> float:
     return float(np.linalg.lstsq(X, phi, rcond=None)[0][4])
 
 
+def agreement(table: pd.DataFrame, ok: pd.DataFrame) -> dict[str, float]:
+    """Ours against the paper over the solved designs ``ok`` (columns set, phi, phi_paper):
+    median ratio, Spearman, R² (squared Pearson), dPhi/dr_FS ours and the paper's."""
+    many = len(ok) > 2
+    return {"ratio": float(np.median(ok.phi / ok.phi_paper)),
+            "rho": spearmanr(ok.phi, ok.phi_paper)[0] if many else np.nan,
+            "r2": np.corrcoef(ok.phi, ok.phi_paper)[0, 1] ** 2 if many else np.nan,
+            "slope": _slope(table, ok.set.to_numpy(), ok.phi.to_numpy()),
+            "paper_slope": _slope(table, ok.set.to_numpy(), ok.phi_paper.to_numpy())}
+
+
 def summary(out: Path):
     df = pd.read_csv(out)
     if "tip_relief" not in df:
@@ -101,14 +112,11 @@ def summary(out: Path):
         table = pd.read_csv(ROOT / "data" / "paper" / TABLES[unit]).set_index("set")
         for (im, zone), d in du.groupby(["interference_m", "zone_deg"]):
             ok = d[d.status == "ok"]
-            ratio = np.median(ok.phi / ok.phi_paper)
-            rho = spearmanr(ok.phi, ok.phi_paper)[0] if len(ok) > 2 else np.nan
-            r2 = np.corrcoef(ok.phi, ok.phi_paper)[0, 1] ** 2 if len(ok) > 2 else np.nan
-            slope = _slope(table, ok.set.to_numpy(), ok.phi.to_numpy())
-            paper = _slope(table, ok.set.to_numpy(), ok.phi_paper.to_numpy())
+            a = agreement(table, ok)
             print(f"{unit} relief {rel:g} δ={im:.2f} m zone {zone:.0f}: {len(ok)}/{len(d)} ok, "
-                  f"Φ {ok.phi.min():.3f}–{ok.phi.max():.3f}, median ratio ours/paper {ratio:.3f}, "
-                  f"Spearman {rho:.3f}, R² {r2:.3f}, dΦ/dr_FS {slope:.4f} ({paper:.4f}) arcmin/µm, "
+                  f"Φ {ok.phi.min():.3f}–{ok.phi.max():.3f}, median ratio ours/paper {a['ratio']:.3f}, "
+                  f"Spearman {a['rho']:.3f}, R² {a['r2']:.3f}, "
+                  f"dΦ/dr_FS {a['slope']:.4f} ({a['paper_slope']:.4f}) arcmin/µm, "
                   f"solve median {ok.solve_s.median():.1f} s (max {ok.solve_s.max():.1f})")
 
 

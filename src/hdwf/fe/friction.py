@@ -154,10 +154,6 @@ class FlankFriction:
         """Working-set pairs the cache covers."""
         return self.normal_slip.shape[0]
 
-    @property
-    def columns(self) -> np.ndarray:
-        return self.store.columns
-
     def copy(self) -> "FlankFriction":
         new = FlankFriction(self.mu, self.nwatch)
         new.store = self.store.copy()

@@ -118,11 +118,6 @@ class WorkingSet:
         new.compliance = self.compliance.copy()
         return new
 
-    @property
-    def columns(self) -> np.ndarray:
-        """Compliance columns K^-1 G^T (nwatch x pairs) of the working set."""
-        return self.store.columns
-
     def add(self, structure: Structure, rows: dict[str, Rows],
             ids: list[PairId]) -> AddedPairs | None:
         """Enter the pairs ``ids`` not yet in the working set; None if there are none."""
