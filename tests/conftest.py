@@ -1,8 +1,18 @@
-from pathlib import Path
+import os
 
-import numpy as np
-import pandas as pd
-import pytest
+# One BLAS thread per test process, set before numpy loads OpenBLAS: the two workers of
+# `pytest -n 2` already fill the two cores, and OpenBLAS threads on top spin against the other
+# worker. A full-model solve measured 34 s alone, 226 s beside a second one, 35 s beside it with
+# one thread each. (Snakemake sets these for its jobs itself; the solver gains nothing from
+# more threads.)
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+import pytest  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "data" / "paper"

@@ -203,6 +203,7 @@ def test_validation_campaign_chain(tmp_path):
     bad.to_csv(data_file, index=False)
     run = subprocess.run([SNAKEMAKE, "--cores", "2", target], cwd=ws, capture_output=True, text=True, timeout=120)
     assert run.returncode != 0
-    assert "tiny.csv" in run.stderr and "row 7" in run.stderr  # row 1 = first data row and "twist_arcmin" in run.stderr, run.stderr[-2000:]
+    # row 1 is the first data row
+    assert "tiny.csv" in run.stderr and "row 7" in run.stderr and "twist_arcmin" in run.stderr, run.stderr[-2000:]
     after = {p: p.read_bytes() for p in (ws / "results/validation").rglob("*") if p.is_file()}
     assert after == before
