@@ -104,3 +104,29 @@ def test_full_report_stage_with_a_paper_study_only(named_inputs, tmp_path):
     if shutil.which("pdftotext"):
         text = _pdf_text(pdf)
         assert "Part I — the paper's FEA tables (study 'paper')" in text and "Part II — our FE model" not in text
+
+
+def test_knee_section_fits_both_models(named_inputs, tmp_path):
+    """Part II's knee: the paper's Table 4 gives its published hinge (tests/study/test_knee.py);
+    a model with the rigid law Φ = 2 (r_FS + r_CS) / r_b (no preload) has slope 0.342 arcmin/µm,
+    12× the paper's least-squares 0.028; the section typesets."""
+    import dataclasses
+
+    import pandas as pd
+
+    from hdwf.report.fe_part import knee_section
+
+    paper = study_artefacts("paper", STUDY, artefacts_by_owner(*named_inputs))
+    table = pd.read_parquet(paper.drive("hd42").lost_motion)
+    table["lost_motion_arcmin"] = 0.342e3 * (table["rFS_mm"] + table["rCS_mm"])
+    table.to_parquet(tmp_path / "rigid.parquet")
+    rigid = dataclasses.replace(paper.drive("hd42"), lost_motion=tmp_path / "rigid.parquet")
+    ours = dataclasses.replace(paper, name="fe_at_paper", source="fe", drives=(rigid,))
+    doc = Document("t", "s", PROVENANCE)
+    knee_section(doc, ["hd42"], DATA, paper, ours, tmp_path)
+    rows = next(b for b in doc.blocks if b["type"] == "table")["rows"]
+    assert rows[0][:5] == ["HD 42", "paper", "0.256", "24.6", "0.0669"] and rows[0][7] == "0.0282"
+    assert rows[1][1] == "ours" and rows[1][4] == "0.3420" and rows[1][7] == "0.3420 (12.13×)"
+    pdf = doc.compile(tmp_path / "knee.pdf")
+    if shutil.which("pdftotext"):
+        assert "The knee: lost motion against clearance" in _pdf_text(pdf)

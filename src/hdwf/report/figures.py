@@ -189,6 +189,35 @@ def agreement_figure(pairs: dict[str, tuple[np.ndarray, np.ndarray]], title: str
     _save(fig, path)
 
 
+def knee_figure(panels: dict[str, dict[str, tuple[np.ndarray, np.ndarray, "object"]]], title: str, path) -> None:
+    """Φ against the clearance s with each model's hinge fit, one panel per drive, log Φ axis.
+
+    Parameters
+    ----------
+    panels
+        Panel title -> {model name: (s in µm, Φ in arcmin, its ``hdwf.study.knee.HingeFit``)}.
+    title, path
+        The figure's title and PNG file.
+    """
+    fig, axes = plt.subplots(1, len(panels), figsize=(5.2 * len(panels), 4.2), squeeze=False)
+    for ax, (label, models) in zip(axes[0], panels.items()):
+        for (name, (s, phi, fit)), colour in zip(models.items(), ("tab:blue", "tab:red")):
+            ax.plot(s, phi, "o", mfc="none", color=colour, label=f"{name} (R² {fit.r2:.2f})")
+            xs = np.linspace(min(s.min(), fit.knee_um), s.max(), 200)
+            ys = fit.predict(xs)
+            ax.plot(xs[ys > 0], ys[ys > 0], "-", color=colour, lw=1)
+            if fit.knee_um > s.min():
+                ax.axvline(fit.knee_um, color=colour, ls=":", lw=0.8)
+        ax.set_yscale("log")
+        ax.set_xlabel("clearance s = r_FS + r_CS + weighted radial shortfall (µm)")
+        ax.set_ylabel("Φ (arcmin)")
+        ax.set_title(label, fontsize=10)
+        ax.legend(fontsize=7)
+        ax.grid(alpha=0.3, which="both")
+    fig.suptitle(title)
+    _save(fig, path)
+
+
 def _without_rotation(p: np.ndarray, u: np.ndarray) -> np.ndarray:
     """u minus its least-squares rigid rotation about the drive axis (what deforms, not what turns)."""
     theta = float(np.sum(p[0] * u[1] - p[1] * u[0]) / np.sum(p[0] ** 2 + p[1] ** 2))
