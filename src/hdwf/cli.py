@@ -132,7 +132,8 @@ def _synth(args) -> int:
 
 def _effects(args) -> int:
     for eff in registry().values():
-        print(f"{eff.name}: {eff.title}{' (in series at the output)' if eff.series else ''}")
+        notes = (" (in series at the output)" if eff.series else "") + (" (offered by name only)" if eff.named_only else "")
+        print(f"{eff.name}: {eff.title}{notes}")
         for p in eff.parameters:
             print(f"    {p.name} [{p.unit}] in [{p.lower:g}, {p.upper:g}], realistic {p.realistic:g}"
                   + "".join(f" ({u}: {v:g})" for u, v in p.realistic_by_unit) + f": {p.description}")

@@ -61,9 +61,12 @@ def design_parameters(designs_path, design_id: str) -> dict[str, float]:
     return {c: float(row.iloc[0][c]) for c in PARAMETER_COLUMNS}
 
 
-def geometry_of(unit: str, params: Mapping[str, float]) -> DriveGeometry:
-    """The drive geometry of ``unit`` at the design parameters ``params`` (keys ``d_mm`` …)."""
-    return drive_geometry(unit, params["d_mm"], params["D_mm"], params["Gr_mm"], params["rFS_mm"], params["rCS_mm"])
+def geometry_of(unit: str, params: Mapping[str, float], interference_m: float = 0.0,
+                tip_relief: float = 0.0) -> DriveGeometry:
+    """The drive geometry of ``unit`` at the design parameters ``params`` (keys ``d_mm`` …), with
+    the preloaded engagement and tip relief of ``drive_geometry`` (default: none)."""
+    return drive_geometry(unit, params["d_mm"], params["D_mm"], params["Gr_mm"], params["rFS_mm"], params["rCS_mm"],
+                          interference_m=interference_m, tip_relief=tip_relief)
 
 
 def mesh_design(unit: str, params: Mapping[str, float], settings: Mapping | MeshSettings) -> DriveMesh:

@@ -46,6 +46,11 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
+# The relief a preloaded engagement is solved with (``DriveGeometry.tip_relief``), 10 % over the
+# derived one: the mounted FS withdraws a little less than the rack path, and at 1.0 the tips of
+# loose-bearing designs still touched at the exit (docs/fe-model.md, "Tip relief").
+PRELOAD_TIP_RELIEF = 1.1
+
 
 def _advance(two_phi, kappa):
     """The FS tooth's tangential advance s / m at 2 phi."""

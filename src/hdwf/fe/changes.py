@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+from hdwf.drive.relief import PRELOAD_TIP_RELIEF
+
 
 @dataclass(frozen=True)
 class ModelChanges:
@@ -38,6 +40,10 @@ class ModelChanges:
       bridged by Coulomb sliders, the compliance spread evenly over their slip torques) of
       density a = 2 w / T^2, T the peak torque of the path (the test torque); its twist
       follows the load path with the Masing rule (``hdwf.fe.cycle.microslip_twist``).
+    * ``flank_interference_m``: preloaded engagement, the FS teeth thicker by this many modules
+      on each flank (``DriveGeometry.interference_m``), their tips relieved as a preload needs
+      (``hdwf.drive.relief.PRELOAD_TIP_RELIEF``). It changes the section's outline, so the
+      geometry must carry it (``geometry_part``): a variant with it is meshed on its own.
     """
     flank_friction: float = 0.0
     cs_rim_stiffness_N_mm2: float = math.inf
@@ -45,6 +51,12 @@ class ModelChanges:
     output_compliance_rad_per_Nmm: float = 0.0
     output_play_rad: float = 0.0
     output_microslip_loop_rad: float = 0.0
+    flank_interference_m: float = 0.0
+
+    def geometry_part(self) -> dict[str, float]:
+        """The ``drive_geometry`` arguments these changes need (``interference_m``, ``tip_relief``)."""
+        relieved = PRELOAD_TIP_RELIEF if self.flank_interference_m > 0 else 0.0
+        return {"interference_m": self.flank_interference_m, "tip_relief": relieved}
 
     def fe_part(self) -> "ModelChanges":
         """The changes that need a new contact solve: all but the series elements."""

@@ -345,6 +345,16 @@ def _zone(geom: DriveGeometry, zone_deg: float | None) -> float:
     return PRELOAD_ZONE_DEG if geom.interference_m > 0 else ZONE_DEG
 
 
+def _check_geometry(geom: DriveGeometry, changes: ModelChanges) -> None:
+    """Changes that reshape the section (``ModelChanges.geometry_part``) must come with a geometry
+    made with them: the solve cannot thicken the teeth of a mesh it is given."""
+    if changes.flank_interference_m > 0:
+        need = changes.geometry_part()
+        if (need["interference_m"], need["tip_relief"]) != (geom.interference_m, geom.tip_relief):
+            raise ValueError(f"changes with {need} need a geometry made with them (ModelChanges.geometry_part); "
+                             f"this one has interference_m={geom.interference_m}, tip_relief={geom.tip_relief}")
+
+
 def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int = 5,
                       E: float | None = None, max_iter: int = 200,
                       tol_gap: float = TOL_GAP, keep_fields: bool = False,
@@ -382,6 +392,7 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
         Status "ok", or "failed" with a reason and no number.
     """
     changes = ModelChanges() if changes is None else changes
+    _check_geometry(geom, changes)
     t0 = time.perf_counter()
     frac = torque_fractions(steps_per_ramp)
     model = None
@@ -426,6 +437,8 @@ def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_r
     list of LostMotionResult
         One per variant, in order.
     """
+    for ch in variants:
+        _check_geometry(geom, ch)
     if geom.interference_m > 0:
         return _preloaded_variants(geom, mesh, steps_per_ramp, variants)
     t0 = time.perf_counter()

@@ -8,7 +8,8 @@ A *table* holds the solved curves of a specimen's variants, one row per load ste
 
 Reuse between candidates (what makes a campaign affordable):
 
-* one mesh per specimen, built once and shared by every variant of that specimen;
+* one mesh per specimen, built once and shared by every variant of that specimen (a variant
+  that reshapes the section, a preload, gets a mesh of its own, shared by its variants);
 * one assembly and factorisation of the bodies and one wave-generator stage per specimen:
   every effect acts only once the teeth engage (``hdwf.fe.solve_lost_motion_variants``),
   so each variant costs only its torque sequence (and the housing a new CS factorisation);
@@ -36,7 +37,7 @@ import pandas as pd
 from tqdm import tqdm
 
 from hdwf import PARAMETER_COLUMNS
-from hdwf.drive.design import geometry_of, mesh_design
+from hdwf.drive.design import MeshSettings, geometry_of
 from hdwf.drive.geometry import ARCMIN
 from hdwf.fe import ModelChanges, series_output_twist, solve_lost_motion_variants
 from hdwf.validation.effects import get as get_effect
@@ -96,7 +97,8 @@ def variant_key(effects: dict[str, dict[str, float]]) -> str:
 
 
 def candidate_names(fixed: dict | None = None) -> list[str]:
-    """Every registered effect that is not already part of the campaign's model.
+    """Every registered effect that is not already part of the campaign's model, but those
+    offered only by name (``Effect.named_only``).
 
     Parameters
     ----------
@@ -108,7 +110,7 @@ def candidate_names(fixed: dict | None = None) -> list[str]:
     list of str
         Effect names in registry order.
     """
-    return [n for n in registry() if n not in (fixed or {})]
+    return [n for n, eff in registry().items() if n not in (fixed or {}) and not eff.named_only]
 
 
 def plan_variants(fixed: dict[str, dict[str, float]] | None = None,
@@ -167,11 +169,18 @@ def solve_specimen(setup: SolveSetup, specimen: Mapping, variants: list[dict]) -
         solve fails gets ``status = "failed: <reason>"`` and NaN twists.
     """
     params = {c: float(specimen[c]) for c in PARAMETER_COLUMNS}
-    mesh = mesh_design(setup.unit, params, setup.mesh)
+    settings = MeshSettings.from_mapping(setup.mesh)
     steps = setup.steps_per_ramp
     changes = [model_changes(eff) for eff in variants]
     parts = list(dict.fromkeys(ch.fe_part() for ch in changes))   # distinct, in order
-    solved = dict(zip(parts, solve_lost_motion_variants(geometry_of(setup.unit, params), mesh, steps, parts)))
+    # one geometry and mesh per outline (a preload thickens the teeth), shared by its variants
+    outlines: dict[tuple, list[ModelChanges]] = {}
+    for part in parts:
+        outlines.setdefault(tuple(sorted(part.geometry_part().items())), []).append(part)
+    solved = {}
+    for outline, group in outlines.items():
+        geom = geometry_of(setup.unit, params, **dict(outline))
+        solved.update(zip(group, solve_lost_motion_variants(geom, settings.mesh(geom), steps, group)))
     frames = []
     for eff, ch in zip(variants, changes):
         res = solved[ch.fe_part()]

@@ -100,6 +100,9 @@ class Effect:
     parameters: tuple[Parameter, ...]
     apply: Callable[..., ModelChanges]   # (changes, **params) -> changes
     series: bool = False                 # acts in series at the output: no new contact solve
+    # a design value (read off the drawing for a bench drive), not something that happens to a
+    # drive: offered only where a campaign names it, never by ``candidates: all``
+    named_only: bool = False
     references: str = ""
     off: dict = field(default_factory=dict)   # parameter values that switch it off
 
