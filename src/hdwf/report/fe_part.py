@@ -198,7 +198,9 @@ def agreement_section(doc: Document, units: list[str], paper: StudyArtefacts, ou
                width="100%" if len(pairs) > 1 else "55%")
     doc.text("The ranking is what the study needs (which parameters matter); the level differs by the median ratio "
              "above. Our 2D section has rigid-body flank backlash from $r_\"FS\"$, $r_\"CS\"$ with little preload "
-             "to take it up; the paper's 3D model evidently takes most of it up.")
+             "to take it up; the paper's 3D model evidently takes most of it up. The campaigns `paper_hd42` and "
+             "`paper_hd120` of Part III search for the effect that does (a preloaded engagement among the "
+             "candidates), and the knee below shows what is left.")
 
 
 def knee_section(doc: Document, units: list[str], data_dir: Path, paper: StudyArtefacts, ours: StudyArtefacts,
