@@ -235,7 +235,7 @@ def knee_section(doc: Document, units: list[str], data_dir: Path, paper: StudyAr
             ok = table["lost_motion_arcmin"].notna().to_numpy()
             models[name] = (fit.clearance_um(table[ok], nominal), table["lost_motion_arcmin"].to_numpy(float)[ok], fit)
             rows.append([UNIT_NAMES[u], name, fmt(fit.floor_arcmin, 3), fmt(fit.knee_um, 1),
-                         fmt(fit.slope_arcmin_per_um, 4), ", ".join(fmt(w, 2) for w in fit.weights), fmt(fit.r2, 3),
+                         fmt(fit.slope_arcmin_per_um, 4), ", ".join(fmt(w, 3) for w in fit.weights), fmt(fit.r2, 3),
                          fmt(slopes[name], 4)])
         rows[-1][-1] += f" ({fmt(slopes['ours'] / slopes['paper'], 2)}×)"
         panels[UNIT_NAMES[u]] = models
