@@ -13,6 +13,7 @@ from scipy.optimize import isotonic_regression
 
 from hdwf import PARAMETER_COLUMNS, PARAMETER_LABELS, PARAMETERS
 from hdwf.common.io import atomic_path
+from hdwf.study.knee import HingeFit
 
 # Files only, never a window: the same backend on every machine, whatever MPLBACKEND says.
 matplotlib.use("Agg")
@@ -189,7 +190,7 @@ def agreement_figure(pairs: dict[str, tuple[np.ndarray, np.ndarray]], title: str
     _save(fig, path)
 
 
-def knee_figure(panels: dict[str, dict[str, tuple[np.ndarray, np.ndarray, "object"]]], title: str, path) -> None:
+def knee_figure(panels: dict[str, dict[str, tuple[np.ndarray, np.ndarray, HingeFit]]], title: str, path) -> None:
     """Φ against the clearance s with each model's hinge fit, one panel per drive, log Φ axis.
 
     Parameters

@@ -23,6 +23,8 @@ import numpy as np
 import pandas as pd
 from scipy.optimize import least_squares
 
+from hdwf import PARAMETER_COLUMNS
+
 RADIAL = ("d_mm", "D_mm", "Gr_mm")   # the radial changes weighted into the clearance, in this order
 
 
@@ -62,11 +64,17 @@ class HingeFit:
         return self.floor_arcmin + self.slope_arcmin_per_um * np.maximum(0.0, np.asarray(clearance) - self.knee_um)
 
 
+def _clearance_terms(designs: pd.DataFrame, nominal: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
+    """r_FS + r_CS and the half radial changes Δk/2 (one column per ``RADIAL``), in µm."""
+    half_changes = 1e3 * np.column_stack([(designs[c].to_numpy(float) - nominal[c]) / 2.0 for c in RADIAL])
+    offsets = 1e3 * (designs["rFS_mm"].to_numpy(float) + designs["rCS_mm"].to_numpy(float))
+    return offsets, half_changes
+
+
 def clearance_um(designs: pd.DataFrame, nominal: Mapping[str, float], weights) -> np.ndarray:
     """s = r_FS + r_CS + Σ w_k Δk/2 in µm, Δ from the nominal design (columns ``*_mm``)."""
-    half_changes = np.column_stack([(designs[c].to_numpy(float) - nominal[c]) / 2.0 for c in RADIAL])
-    offsets = designs["rFS_mm"].to_numpy(float) + designs["rCS_mm"].to_numpy(float)
-    return 1e3 * (offsets + half_changes @ np.asarray(weights, float))
+    offsets, half_changes = _clearance_terms(designs, nominal)
+    return offsets + half_changes @ np.asarray(weights, float)
 
 
 def fit_hinge(designs: pd.DataFrame, nominal: Mapping[str, float],
@@ -92,8 +100,7 @@ def fit_hinge(designs: pd.DataFrame, nominal: Mapping[str, float],
     if len(table) < 7:
         raise ValueError(f"a hinge in six parameters needs at least 7 designs, got {len(table)}")
     y = table[column].to_numpy(float)
-    half_changes = 1e3 * np.column_stack([(table[c].to_numpy(float) - nominal[c]) / 2.0 for c in RADIAL])
-    offsets = 1e3 * (table["rFS_mm"].to_numpy(float) + table["rCS_mm"].to_numpy(float))
+    offsets, half_changes = _clearance_terms(table, nominal)
 
     def residual(p):
         floor, slope, knee, *w = p
@@ -126,7 +133,6 @@ def offset_slopes(designs: pd.DataFrame, column: str = "lost_motion_arcmin") -> 
         The coefficients of r_FS and r_CS per µm.
     """
     table = designs[np.isfinite(designs[column].to_numpy(float))]
-    cols = ["d_mm", "D_mm", "Gr_mm", "rFS_mm", "rCS_mm"]
-    A = np.column_stack([np.ones(len(table)), table[cols].to_numpy(float)])
-    coef = np.linalg.lstsq(A, table[column].to_numpy(float), rcond=None)[0]
-    return float(coef[4]) * 1e-3, float(coef[5]) * 1e-3
+    A = np.column_stack([np.ones(len(table)), table[list(PARAMETER_COLUMNS)].to_numpy(float)])
+    coef = dict(zip(("intercept", *PARAMETER_COLUMNS), np.linalg.lstsq(A, table[column].to_numpy(float), rcond=None)[0]))
+    return float(coef["rFS_mm"]) * 1e-3, float(coef["rCS_mm"]) * 1e-3
