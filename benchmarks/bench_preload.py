@@ -2,7 +2,7 @@
 
 Solves each design of the paper's table (coarse half mesh, 5 x 3 elements per tooth, as the
 tests use; 5 steps per ramp) at every ``--interference`` (units of the module m) and appends
-one row per solve to ``--out`` (CSV: unit, set, interference_m, zone_deg, status, Phi, the
+one row per solve to ``--out`` (CSV: unit, set, interference_m, mesh, zone_deg, status, Phi, the
 paper's Phi, solve and mesh seconds, teeth in contact, the ramp's overlap).  Interference 0
 runs at today's 35 deg zones; ``--zone90`` adds interference 0 with every tooth watched (the
 zones a preload uses), which separates the zone from the preload.  Then it prints, per
@@ -55,23 +55,25 @@ def _sets(text: str) -> list[int]:
 
 
 def solve_all(unit: str, sets: list[int], interferences: list[float], zone90: bool, out: Path,
-              tip_relief: float = 0.0, zone: float | None = None):
+              tip_relief: float = 0.0, zone: float | None = None, mesh_size: tuple[int, int] = (5, 3)):
     table = pd.read_csv(ROOT / "data" / "paper" / TABLES[unit]).set_index("set")
     for s in sets:
         row = table.loc[s]
         g0 = drive_geometry(unit, *(row[c] for c in COLUMNS), tip_relief=tip_relief)
         t0 = time.perf_counter()
-        mesh = build_mesh(g0, elements_over_height=5, elements_over_thickness=3, symmetry="half")
+        eh, et = mesh_size
+        mesh = build_mesh(g0, elements_over_height=eh, elements_over_thickness=et, symmetry="half")
         mesh_s = time.perf_counter() - t0
         runs = [(i, zone) for i in interferences] + ([(0.0, 90.0)] if zone90 else [])
         for im, zone_deg in runs:
             # interference is a flank offset of the FS teeth: a new outline, a new mesh
             g = drive_geometry(unit, *(row[c] for c in COLUMNS), interference_m=im,
                                tip_relief=tip_relief)
-            m = mesh if im == 0 else build_mesh(g, elements_over_height=5, elements_over_thickness=3,
+            m = mesh if im == 0 else build_mesh(g, elements_over_height=eh, elements_over_thickness=et,
                                                 symmetry="half")
             r = solve_lost_motion(g, m, steps_per_ramp=5, zone_deg=zone_deg)
             rec = {"unit": unit, "set": s, "interference_m": im, "tip_relief": tip_relief,
+                   "mesh": f"{eh}x{et}",
                    "zone_deg": zone_deg if zone_deg else (90.0 if im > 0 else 35.0),
                    "status": r.status, "overlap_outside_zones_um": r.overlap_outside_zones_um,
                    "reason": r.reason[:200], "phi": r.lost_motion_arcmin,
@@ -108,12 +110,14 @@ def summary(out: Path):
     df = pd.read_csv(out)
     if "tip_relief" not in df:
         df["tip_relief"] = 0.0
-    for (unit, rel), du in df.groupby(["unit", "tip_relief"]):
+    if "mesh" not in df:
+        df["mesh"] = "5x3"
+    for (unit, rel, size), du in df.groupby(["unit", "tip_relief", "mesh"]):
         table = pd.read_csv(ROOT / "data" / "paper" / TABLES[unit]).set_index("set")
         for (im, zone), d in du.groupby(["interference_m", "zone_deg"]):
             ok = d[d.status == "ok"]
             a = agreement(table, ok)
-            print(f"{unit} relief {rel:g} δ={im:.2f} m zone {zone:.0f}: {len(ok)}/{len(d)} ok, "
+            print(f"{unit} mesh {size} relief {rel:g} δ={im:.2f} m zone {zone:.0f}: {len(ok)}/{len(d)} ok, "
                   f"Φ {ok.phi.min():.3f}–{ok.phi.max():.3f}, median ratio ours/paper {a['ratio']:.3f}, "
                   f"Spearman {a['rho']:.3f}, R² {a['r2']:.3f}, "
                   f"dΦ/dr_FS {a['slope']:.4f} ({a['paper_slope']:.4f}) arcmin/µm, "
@@ -131,9 +135,11 @@ if __name__ == "__main__":
                     help="DriveGeometry.tip_relief (multiple of the derived relief)")
     ap.add_argument("--zone", type=float, default=None,
                     help="zone half width (deg) for every run (default: by interference)")
+    ap.add_argument("--mesh", default="5x3",
+                    help="elements over the tooth height x thickness (10x6 is the studies' default)")
     ap.add_argument("--summary-only", action="store_true")
     a = ap.parse_args()
     if not a.summary_only:
         solve_all(a.unit, _sets(a.sets), [float(x) for x in a.interference.split(",")], a.zone90,
-                  a.out, a.tip_relief, a.zone)
+                  a.out, a.tip_relief, a.zone, tuple(int(n) for n in a.mesh.split("x")))
     summary(a.out)

@@ -108,6 +108,7 @@ def _check_relations(config: dict, source) -> None:
             # The check compares the two finest meshes, so the study's own mesh must be one of them.
             raise ConfigError(source, "the default mesh must be one of the two finest of the three",
                               field="fe.refinement", value=fe["refinement"])
+        _check_effects("fe", fe.get("effects", {}), source)
         for key in ("convergence", "picture"):
             study = fe.get(key, {}).get("study")
             if study is not None and (study not in config["studies"] or config["studies"][study]["source"] != "fe"):
@@ -132,7 +133,19 @@ def _check_campaign(name: str, camp: dict, source) -> None:
     """Effect names, parameters and values of a campaign against the effects registry."""
     known = registry()
     where = f"validation.{name}"
-    for eff, params in camp.get("effects", {}).items():
+    _check_effects(where, camp.get("effects", {}), source)
+    cands = camp.get("candidates", "all")
+    if cands != "all":
+        for c in cands:
+            if c not in known:
+                raise ConfigError(source, f"unknown effect; known: {', '.join(known)}", field=f"{where}.candidates",
+                                  value=c)
+
+
+def _check_effects(where: str, effects: dict, source) -> None:
+    """Switched-on effects ``{name: {parameter: value | calibrate}}`` under ``where`` against the registry."""
+    known = registry()
+    for eff, params in effects.items():
         if eff not in known:
             raise ConfigError(source, f"unknown effect; known: {', '.join(known)}", field=f"{where}.effects",
                               value=eff)
@@ -151,12 +164,6 @@ def _check_campaign(name: str, camp: dict, source) -> None:
         if missing:
             raise ConfigError(source, f"give every parameter of {eff} (missing {', '.join(sorted(missing))})",
                               field=f"{where}.effects.{eff}")
-    cands = camp.get("candidates", "all")
-    if cands != "all":
-        for c in cands:
-            if c not in known:
-                raise ConfigError(source, f"unknown effect; known: {', '.join(known)}", field=f"{where}.candidates",
-                                  value=c)
 
 
 def load_config(path: str | Path, schema_path: str | Path = SCHEMA_PATH) -> dict:

@@ -36,6 +36,10 @@ def test_shipped_config_is_valid():
     (lambda c: c["sobol"].update(samplers=["monte-carlo"]), "sobol.samplers.0", "monte-carlo"),
     (lambda c: c["studies"]["paper"].update(units=["hd50"]), "studies.paper.units.0", "hd50"),
     (lambda c: c["sobol"].update(n_start=100), "sobol.n_start", 100),                  # not a power of two
+    (lambda c: c["fe"].update(effects={"preloud": {"interference_m": 0.1}}), "fe.effects", "preloud"),  # no such effect
+    (lambda c: c["fe"].update(effects={"preload": {"interference_m": 0.5}}),                          # out of bounds
+     "fe.effects.preload.interference_m", 0.5),
+    (lambda c: c["fe"].update(effects={"preload": {"delta": 0.1}}), "fe.effects.preload.delta", "delta"),
 ])
 def test_bad_config_names_file_field_and_value(tmp_path, edit, field, value):
     path = _config_with(tmp_path, edit)

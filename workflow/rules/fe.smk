@@ -24,6 +24,7 @@ rule fe_mesh:
         npz="results/{study}/{unit}/mesh/{design}.npz",
     params:
         settings={k: FE[k] for k in ("elements_over_height", "elements_over_thickness", "refinement", "symmetry")},
+        effects=FE["effects"],
     threads: 1
     log:
         "results/logs/{study}_{unit}_mesh_{design}.log",
@@ -40,6 +41,7 @@ rule fe_solve:
         curve="results/{study}/{unit}/designs/{design}_curve.parquet",
     params:
         steps_per_ramp=FE["steps_per_ramp"],
+        effects=FE["effects"],
     threads: 1
     resources:
         mem_mb=4000,
@@ -63,6 +65,9 @@ rule fe_aggregate:
         curves="results/{study}/{unit}/curves.parquet",
     wildcard_constraints:
         study=_alternatives(FE_STUDIES),
+    params:
+        effects=FE["effects"],
+        calibrated_on=FE.get("calibrated_on"),
     log:
         "results/logs/{study}_{unit}_aggregate.log",
     script:
@@ -80,6 +85,7 @@ rule fe_refined_solve:
                             "elements_over_thickness": FE["elements_over_thickness"], "refinement": float(w.ref),
                             "symmetry": FE["symmetry"]},
         steps_per_ramp=FE["steps_per_ramp"],
+        effects=FE["effects"],
     threads: 1
     resources:
         mem_mb=4000,
@@ -115,6 +121,7 @@ rule fe_deformed:
     params:
         settings={k: FE[k] for k in ("elements_over_height", "elements_over_thickness", "refinement", "symmetry")},
         steps_per_ramp=FE["steps_per_ramp"],
+        effects=FE["effects"],
     threads: 1
     log:
         "results/logs/{study}_{unit}_deformed_{design}.log",

@@ -11,5 +11,7 @@ if "snakemake" not in globals():  # run by hand, e.g. to debug one step (see _he
 prov = setup(snakemake)
 w = snakemake.wildcards
 rows = aggregate_stage(snakemake.input.rows, snakemake.input.curves, snakemake.output.lost_motion,
-                       snakemake.output.curves, prov, {"study": w.study, "unit": w.unit, "source": "hdwf FE"})
+                       snakemake.output.curves, prov, {"study": w.study, "unit": w.unit, "source": "hdwf FE",
+                                         "effects": dict(snakemake.params.effects),
+                                         "calibrated_on": snakemake.params.calibrated_on})
 logging.info("%d designs, %d ok", len(rows), int((rows["status"] == "ok").sum()))

@@ -11,5 +11,6 @@ if "snakemake" not in globals():  # run by hand, e.g. to debug one step (see _he
 prov = setup(snakemake)
 w = snakemake.wildcards
 facts = deformed_stage(snakemake.input[0], w.design, w.unit, dict(snakemake.params.settings),
-                       snakemake.params.steps_per_ramp, snakemake.output.png, snakemake.output.fields, prov)
+                       snakemake.params.steps_per_ramp, snakemake.output.png, snakemake.output.fields, prov,
+                       effects=dict(snakemake.params.effects))
 logging.info("%s", facts)

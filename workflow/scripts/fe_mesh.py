@@ -11,5 +11,6 @@ if "snakemake" not in globals():  # run by hand, e.g. to debug one step (see _he
 setup(snakemake)
 w = snakemake.wildcards
 facts = mesh_stage(snakemake.input[0], w.design, w.unit, dict(snakemake.params.settings),
-                   snakemake.output.msh, snakemake.output.npz)
+                   snakemake.output.msh, snakemake.output.npz,
+                   effects=dict(snakemake.params.effects))
 logging.info("%s", facts)

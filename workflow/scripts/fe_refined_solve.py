@@ -11,5 +11,6 @@ if "snakemake" not in globals():  # run by hand, e.g. to debug one step (see _he
 prov = setup(snakemake)
 w = snakemake.wildcards
 row = refined_solve_stage(snakemake.input[0], w.design, w.unit, dict(snakemake.params.settings),
-                          snakemake.params.steps_per_ramp, snakemake.output[0], prov)
+                          snakemake.params.steps_per_ramp, snakemake.output[0], prov,
+                          effects=dict(snakemake.params.effects))
 logging.info("%s", row)

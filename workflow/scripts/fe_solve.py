@@ -11,5 +11,6 @@ if "snakemake" not in globals():  # run by hand, e.g. to debug one step (see _he
 prov = setup(snakemake)
 w = snakemake.wildcards
 row = solve_stage(snakemake.input.designs, w.design, w.unit, snakemake.input.mesh,
-                  snakemake.params.steps_per_ramp, snakemake.output.row, snakemake.output.curve, prov)
+                  snakemake.params.steps_per_ramp, snakemake.output.row, snakemake.output.curve, prov,
+                  effects=dict(snakemake.params.effects))
 logging.info("%s", row)

@@ -4,7 +4,8 @@ open the files themselves."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Mapping
 from pathlib import Path
 
 from hdwf.drive.design import MeshSettings
@@ -69,10 +70,14 @@ class CampaignArtefacts:
 
 @dataclass(frozen=True)
 class FeSettings:
-    """The FE settings the report quotes (config ``fe``): the default mesh and the load steps."""
+    """The FE settings the report quotes (config ``fe``): the default mesh, the load steps, the
+    effects switched on in the FE studies (``{name: {parameter: value}}``) and the drive whose
+    data set their values (the other drive's agreement is then a blind prediction)."""
 
     mesh: MeshSettings
     steps_per_ramp: int
+    effects: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    calibrated_on: str | None = None
 
 
 @dataclass(frozen=True)

@@ -23,6 +23,7 @@ from hdwf.study.aggregate import write_lost_motion
 from hdwf.study.convergence import convergence_table
 from hdwf.study.fe_design import solve_design
 from hdwf.study.paper import load_fea_designs
+from hdwf.validation.effects import model_changes
 
 
 def designs_stage(source: str, unit: str, source_path, data_dir, out, provenance: dict) -> pd.DataFrame:
@@ -37,9 +38,13 @@ def designs_stage(source: str, unit: str, source_path, data_dir, out, provenance
     return df
 
 
-def mesh_stage(designs_path, design_id: str, unit: str, settings: Mapping, out_msh, out_npz) -> dict:
-    """Mesh one design: gmsh ``.msh`` for review, ``.npz`` for the solver; returns mesh facts."""
-    geom = geometry_of(unit, design_parameters(designs_path, design_id))
+def mesh_stage(designs_path, design_id: str, unit: str, settings: Mapping, out_msh, out_npz,
+               effects: Mapping | None = None) -> dict:
+    """Mesh one design: gmsh ``.msh`` for review, ``.npz`` for the solver; returns mesh facts.
+
+    ``effects`` are the study's switched-on effects (``fe.effects``): the preload reshapes the outline.
+    """
+    geom = geometry_of(unit, design_parameters(designs_path, design_id), **model_changes(effects).geometry_part())
     t0 = time.perf_counter()
     with atomic_path(out_msh) as tmp_msh:
         # gmsh picks the format from the extension, so the temporary name keeps ".msh".
@@ -51,10 +56,12 @@ def mesh_stage(designs_path, design_id: str, unit: str, settings: Mapping, out_m
 
 
 def solve_stage(designs_path, design_id: str, unit: str, mesh_npz, steps_per_ramp: int, out_row, out_curve,
-                provenance: dict) -> dict:
-    """Solve one meshed design into its row and torque–twist curve (Parquet each)."""
+                provenance: dict, effects: Mapping | None = None) -> dict:
+    """Solve one meshed design into its row and torque–twist curve (Parquet each), with the
+    study's switched-on ``effects`` (``{name: {parameter: value}}``, those its mesh was made with)."""
     params = design_parameters(designs_path, design_id)
-    row, curve = solve_design(unit, params, load_drive_mesh(mesh_npz), steps_per_ramp, design_id)
+    row, curve = solve_design(unit, params, load_drive_mesh(mesh_npz), steps_per_ramp, design_id,
+                              changes=model_changes(effects))
     write_parquet(pd.DataFrame([row]), out_row, provenance=provenance, meta={"unit": unit})
     write_parquet(curve, out_curve, provenance=provenance, meta={"unit": unit})
     return row
@@ -71,10 +78,12 @@ def aggregate_stage(row_paths, curve_paths, out_lost_motion, out_curves, provena
 
 
 def refined_solve_stage(designs_path, design_id: str, unit: str, settings: Mapping, steps_per_ramp: int, out,
-                        provenance: dict) -> dict:
+                        provenance: dict, effects: Mapping | None = None) -> dict:
     """Mesh and solve one design at another refinement (mesh-convergence runs); one row out."""
     params = design_parameters(designs_path, design_id)
-    row, _ = solve_design(unit, params, mesh_design(unit, params, settings), steps_per_ramp, design_id)
+    changes = model_changes(effects)
+    row, _ = solve_design(unit, params, mesh_design(unit, params, settings, **changes.geometry_part()), steps_per_ramp,
+                          design_id, changes=changes)
     row["refinement"] = float(settings["refinement"])
     write_parquet(pd.DataFrame([row]), out, provenance=provenance, meta={"unit": unit})
     return row
@@ -93,12 +102,13 @@ def convergence_stage(default_lost_motion, other_rows, default_refinement: float
 
 
 def deformed_stage(designs_path, design_id: str, unit: str, settings: Mapping, steps_per_ramp: int, out_png,
-                   out_npz, provenance: dict) -> dict:
+                   out_npz, provenance: dict, effects: Mapping | None = None) -> dict:
     """Solve one design keeping the displacement fields; picture of the mesh near the major axis."""
     params = design_parameters(designs_path, design_id)
-    geom = geometry_of(unit, params)
+    changes = model_changes(effects)
+    geom = geometry_of(unit, params, **changes.geometry_part())
     mesh = MeshSettings.from_mapping(settings).mesh(geom)
-    res = solve_lost_motion(geom, mesh, steps_per_ramp=steps_per_ramp, keep_fields=True)
+    res = solve_lost_motion(geom, mesh, steps_per_ramp=steps_per_ramp, keep_fields=True, changes=changes)
     if res.status != "ok":
         raise RuntimeError(f"{design_id}: solve failed ({res.reason}); no picture of a failed state")
     arrays = {f"{state}:{body}": u for state, per_body in res.fields.items() for body, u in per_body.items()}

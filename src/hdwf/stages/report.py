@@ -112,6 +112,7 @@ def full_report_stage(studies: Mapping[str, Mapping], fe: Mapping, inputs: Mappi
     report = ReportInputs(
         studies=tuple(study_artefacts(name, cfg, grouped) for name, cfg in studies.items()),
         campaigns=campaigns, data_dir=Path(data_dir),
-        fe_settings=FeSettings(mesh=MeshSettings.from_mapping(fe), steps_per_ramp=fe["steps_per_ramp"]),
+        fe_settings=FeSettings(mesh=MeshSettings.from_mapping(fe), steps_per_ramp=fe["steps_per_ramp"],
+                               effects=fe.get("effects", {}), calibrated_on=fe.get("calibrated_on")),
         assumptions=tuple(assumptions_table()), provenance=provenance)
     return full_report(report, out)

@@ -10,12 +10,13 @@ import pandas as pd
 from hdwf.drive.design import geometry_of
 from hdwf.drive.mesh import DriveMesh
 from hdwf.fe import solve_lost_motion
+from hdwf.fe.changes import ModelChanges
 
 CURVE_COLUMNS = ["design_id", "step", "torque_Nm", "twist_arcmin"]
 
 
 def solve_design(unit: str, params: Mapping[str, float], mesh: DriveMesh, steps_per_ramp: int, design_id: str,
-                 **solver_options) -> tuple[dict, pd.DataFrame]:
+                 changes: ModelChanges | None = None, **solver_options) -> tuple[dict, pd.DataFrame]:
     """Solve one design; return its lost-motion row and its torque–twist curve.
 
     Parameters
@@ -25,13 +26,16 @@ def solve_design(unit: str, params: Mapping[str, float], mesh: DriveMesh, steps_
     mesh : the design's mesh (``hdwf.drive.design``).
     steps_per_ramp : load steps on each of the four ramps of the torque cycle.
     design_id : the id written into the row and the curve.
+    changes : the effects switched on in the study's model (``fe.effects``); a change that reshapes
+        the section (the preload) must also be in the geometry ``mesh`` was made from.
 
     Returns
     -------
     row, curve : a failed solve gives status ``failed: <reason>`` and no Φ (never a silent number).
     """
-    geom = geometry_of(unit, params)
-    res = solve_lost_motion(geom, mesh, steps_per_ramp=steps_per_ramp, **solver_options)
+    changes = ModelChanges() if changes is None else changes
+    geom = geometry_of(unit, params, **changes.geometry_part())
+    res = solve_lost_motion(geom, mesh, steps_per_ramp=steps_per_ramp, changes=changes, **solver_options)
     ok = res.status == "ok"
     row = {"design_id": design_id, **params,
            "phi_plus_arcmin": res.phi_plus_arcmin if ok else np.nan,
