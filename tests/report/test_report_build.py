@@ -130,3 +130,31 @@ def test_knee_section_fits_both_models(named_inputs, tmp_path):
     pdf = doc.compile(tmp_path / "knee.pdf")
     if shutil.which("pdftotext"):
         assert "The knee: lost motion against clearance" in _pdf_text(pdf)
+
+
+@pytest.mark.parametrize("scale, said", [(1.2, "All met."), (2.0, "median ratio 2.00 outside [0.67, 1.5]")])
+def test_agreement_section_labels_the_blind_drive_and_its_misses(named_inputs, tmp_path, scale, said):
+    """With effects calibrated on another drive, HD 42's row is a blind prediction; ours = the
+    paper's Φ times a constant has Spearman 1 and R² 1, so only the level can miss: 1.2 lies in
+    [0.67, 1.5], 2 does not."""
+    import dataclasses
+
+    import pandas as pd
+
+    from hdwf.drive.design import MeshSettings
+    from hdwf.report.artefacts import FeSettings
+    from hdwf.report.fe_part import agreement_section
+
+    paper = study_artefacts("paper", STUDY, artefacts_by_owner(*named_inputs))
+    table = pd.read_parquet(paper.drive("hd42").lost_motion)
+    table["lost_motion_arcmin"] *= scale
+    table.to_parquet(tmp_path / "scaled.parquet")
+    ours = dataclasses.replace(paper, name="fe_at_paper", source="fe",
+                               drives=(dataclasses.replace(paper.drive("hd42"), lost_motion=tmp_path / "scaled.parquet"),))
+    settings = FeSettings(MeshSettings(), 5, effects={"preload": {"interference_m": 0.147}}, calibrated_on="hd120")
+    doc = Document("t", "s", PROVENANCE)
+    agreement_section(doc, ["hd42"], paper, ours, tmp_path, settings)
+    row = next(b for b in doc.blocks if b["type"] == "table")["rows"][0]
+    assert row[:2] == ["HD 42 (blind)", "27 of 27"] and row[2] == "1.0000" and row[7] == f"{scale:.2f}"
+    text = " ".join(b.get("text", "") for b in doc.blocks if b["type"] == "text")
+    assert said in text and "preloaded" in text.lower() and "0.147" in text

@@ -167,7 +167,7 @@ def curves_section(doc: Document, study: StudyArtefacts, tmp: Path, level: int =
 def effects_text(effects) -> str:
     """``{name: {parameter: value}}`` in words: each effect's title and its parameter values."""
     return "; ".join(f"{get_effect(name).title.lower()} ("
-                     + ", ".join(f"`{p}` = {fmt(v, 4)}" for p, v in params.items()) + ")"
+                     + ", ".join(f"`{p}` = {v:g}" for p, v in params.items()) + ")"
                      for name, params in effects.items())
 
 
