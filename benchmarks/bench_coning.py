@@ -20,17 +20,11 @@ paper's on the same designs) and the rms of log(ours/paper), the calibration obj
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
 
-os.environ.setdefault("OMP_NUM_THREADS", "1")
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-try:
-    import hdwf  # noqa: F401
-except ImportError:
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
+import _one_thread  # noqa: F401,E402  (first: one BLAS thread, hdwf importable)
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import numpy as np

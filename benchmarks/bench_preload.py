@@ -21,17 +21,10 @@ Pearson correlation ours vs paper) and the paper's dPhi/dr_FS on the same design
 from __future__ import annotations
 
 import argparse
-import os
-import sys
 import time
 from pathlib import Path
 
-os.environ.setdefault("OMP_NUM_THREADS", "1")
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-try:
-    import hdwf  # noqa: F401
-except ImportError:
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
+import _one_thread  # noqa: F401,E402  (first: one BLAS thread, hdwf importable)
 
 import numpy as np
 import pandas as pd

@@ -11,20 +11,12 @@ their ratio, Phi and the peak resident memory of the process (resource.getrusage
 from __future__ import annotations
 
 import argparse
-import os
 import resource
 import statistics
 import sys
 import time
-from pathlib import Path
 
-os.environ.setdefault("OMP_NUM_THREADS", "1")
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-os.environ.setdefault("MKL_NUM_THREADS", "1")
-try:
-    import hdwf  # noqa: F401
-except ImportError:
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
+import _one_thread  # noqa: F401,E402  (first: one BLAS thread, hdwf importable)
 
 from hdwf.fe import solve_lost_motion  # noqa: E402
 from hdwf.drive.geometry import drive_geometry  # noqa: E402

@@ -1,0 +1,63 @@
+"""One design's lost motion on ever finer meshes, with the FE studies' effects: is Φ converged?
+
+Meshes the design of ``--designs`` (a study's ``designs.parquet``, e.g. the default target's
+``results/fe/hd42/designs.parquet``) at each ``--refinements`` factor of the default 10 x 6
+elements per tooth (half model, 5 steps per ramp), solves it with ``--effects`` switched on
+(default: the ``fe.effects`` of ``config.yaml``) and appends one row per mesh to ``--out``
+(CSV: design, refinement, nodes, status, Φ, φ+, φ−, teeth in contact, seconds).
+
+Run with one thread, e.g.
+  python benchmarks/bench_mesh_refinement.py --unit hd42 --designs results/fe/hd42/designs.parquet \\
+      --design hd42-lhs-09 --refinements 1,1.25,1.5,2 --out refine.csv
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+import _one_thread  # noqa: F401,E402  (first: one BLAS thread, hdwf importable)
+
+import pandas as pd
+import yaml
+
+from hdwf.drive.design import design_parameters, geometry_of
+from hdwf.drive.mesh import build_mesh
+from hdwf.fe import solve_lost_motion
+from hdwf.validation.effects import model_changes
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def refine(unit: str, designs: Path, design: str, refinements: list[float], effects: dict, out: Path) -> None:
+    params = design_parameters(designs, design)
+    changes = model_changes(effects)
+    geom = geometry_of(unit, params, **changes.geometry_part())
+    for ref in refinements:
+        t0 = time.perf_counter()
+        mesh = build_mesh(geom, 10, 6, ref, symmetry="half")
+        res = solve_lost_motion(geom, mesh, steps_per_ramp=5, changes=changes)
+        rec = {"design": design, "refinement": ref, "effects": json.dumps(effects),
+               "nodes": sum(b.mesh.p.shape[1] for b in mesh.bodies.values()), "status": res.status,
+               "phi": res.lost_motion_arcmin, "phi_plus": res.phi_plus_arcmin, "phi_minus": res.phi_minus_arcmin,
+               "teeth": res.teeth_in_contact, "seconds": time.perf_counter() - t0}
+        pd.DataFrame([rec]).to_csv(out, mode="a", header=not out.exists(), index=False)
+        print(f"{design} refinement {ref:g}: {res.status} Φ {res.lost_motion_arcmin:.4f} arcmin "
+              f"(φ+ {res.phi_plus_arcmin:.4f}, φ− {res.phi_minus_arcmin:.4f}), {rec['teeth']} teeth, "
+              f"{rec['nodes']} nodes, {rec['seconds']:.1f} s", flush=True)
+
+
+if __name__ == "__main__":
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--unit", choices=("hd42", "hd120"), required=True)
+    ap.add_argument("--designs", type=Path, required=True)
+    ap.add_argument("--design", required=True)
+    ap.add_argument("--refinements", default="0.75,1,1.25,1.5,2")
+    ap.add_argument("--effects", default=None, help='JSON {name: {param: value}}; default: config.yaml fe.effects')
+    ap.add_argument("--out", type=Path, default=Path("refine.csv"))
+    a = ap.parse_args()
+    effects = json.loads(a.effects) if a.effects else \
+        yaml.safe_load((ROOT / "config.yaml").read_text())["fe"].get("effects", {})
+    refine(a.unit, a.designs, a.design, [float(x) for x in a.refinements.split(",")], effects, a.out)
