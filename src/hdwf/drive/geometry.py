@@ -48,7 +48,7 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 from scipy.optimize import brentq
 
-from hdwf.drive.relief import relief_start_depth, tip_relief
+from hdwf.drive.relief import tip_relief
 
 ARCMIN = math.pi / (180.0 * 60.0)  # rad per arcmin
 
@@ -235,17 +235,6 @@ class DriveGeometry:
         return self.tip_relief * tip_relief(depth, self.module, self.addendum, self.alpha,
                                             self.tilt_factor)
 
-    def allowance_share(self, depth):
-        """Share of the thickness allowance (``interference``) an FS flank keeps ``depth`` (mm)
-        below its tip: all of it below the relieved depth, falling linearly to none at the tip.
-        The relief clears the tips the tooth's path makes cross; a full allowance there would
-        make them cross again, and the exit-zone tips would carry the preload (their contacts
-        change from mesh to mesh: docs/fe-model.md, "The studies' model"). 1 without relief."""
-        if not (self.tip_relief and self.interference_m):
-            return 1.0
-        start = relief_start_depth(self.module, self.addendum, self.alpha, self.tilt_factor)
-        return np.clip(np.asarray(depth, dtype=float) / start, 0.0, 1.0)
-
     @property
     def tilt_factor(self) -> float:
         """kappa = 1 - 3 (r_tip - r_n) / r_n: the FS tip's tangential displacement over the
@@ -351,15 +340,13 @@ def fs_half_angle(g: DriveGeometry, r):
 
     Nominal arc thickness at the pitch circle is pi m / 2; the normal offset r_FS on each
     flank rotates that involute by r_FS / r_b towards the tooth centre, the preload
-    interference (``interference``, a thickness allowance) by as much away from it, except
-    towards a relieved tip, where the allowance fades out (``DriveGeometry.allowance_share``).
+    interference (``interference``, a thickness allowance) by as much away from it.
     """
     r = np.asarray(r, dtype=float)
     rb = g.r_fs_base
     ar = np.arccos(np.clip(rb / r, -1, 1))
-    allowance = g.interference * g.allowance_share(g.r_fs_tip - r)
     out = ((math.pi * g.module / 2) / (2 * g.r_fs_pitch) + inv(g.alpha) - inv(ar)
-           - (g.r_fs - allowance) / rb)
+           - (g.r_fs - g.interference) / rb)
     return out - g.relief(g.r_fs_tip - r) / r if g.tip_relief else out
 
 
