@@ -69,13 +69,11 @@ def geometry_of(unit: str, params: Mapping[str, float], interference_m: float = 
                           interference_m=interference_m, tip_relief=tip_relief)
 
 
-def mesh_design(unit: str, params: Mapping[str, float], settings: Mapping | MeshSettings,
-                interference_m: float = 0.0, tip_relief: float = 0.0) -> DriveMesh:
-    """Mesh one design with the given settings (a ``MeshSettings`` or a config mapping), of the
-    outline ``geometry_of`` gives with that preload and tip relief."""
+def mesh_design(unit: str, params: Mapping[str, float], settings: Mapping | MeshSettings) -> DriveMesh:
+    """Mesh one design with the given settings (a ``MeshSettings`` or a config mapping)."""
     if not isinstance(settings, MeshSettings):
         settings = MeshSettings.from_mapping(settings)
-    return settings.mesh(geometry_of(unit, params, interference_m, tip_relief))
+    return settings.mesh(geometry_of(unit, params))
 
 
 def save_drive_mesh(mesh: DriveMesh, path) -> Path:

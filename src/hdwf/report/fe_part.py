@@ -208,7 +208,8 @@ def agreement_section(doc: Document, units: list[str], paper: StudyArtefacts, ou
         Heading level of the section.
     """
     doc.heading("Our FE against the paper's FEA at its own design points", level)
-    settings = settings or FeSettings(mesh=None, steps_per_ramp=0)
+    effects = settings.effects if settings else {}
+    calibrated_on = settings.calibrated_on if settings else None
     rows, pairs, misses = [], {}, []
     for u in units:
         theirs = pd.read_parquet(paper.drive(u).lost_motion).set_index("design_id")["lost_motion_arcmin"]
@@ -218,8 +219,7 @@ def agreement_section(doc: Document, units: list[str], paper: StudyArtefacts, ou
         r = st.pearsonr(both["paper"], both["ours"])
         ratio = both["ours"] / both["paper"]
         pairs[UNIT_NAMES[u]] = (theirs.reindex(mine.index).to_numpy(float), mine.to_numpy(float))
-        role = "" if not (settings.effects and settings.calibrated_on) else \
-            (" (calibrated)" if u == settings.calibrated_on else " (blind)")
+        role = "" if not (effects and calibrated_on) else (" (calibrated)" if u == calibrated_on else " (blind)")
         misses += _misses(UNIT_NAMES[u] + role, rho.statistic, r.statistic ** 2, ratio.median())
         rows.append([UNIT_NAMES[u] + role, f"{len(both)} of {len(mine)}", fmt(rho.statistic), fmt(rho.pvalue, 3), fmt(r.statistic ** 2),
                      fmt(both["paper"].mean(), 3), fmt(both["ours"].mean(), 3), fmt(ratio.median(), 2),
@@ -235,8 +235,8 @@ def agreement_section(doc: Document, units: list[str], paper: StudyArtefacts, ou
     verdict = (f"Targets (level, rank, shape): median ratio within [{lo}, {hi}], Spearman $rho >= "
                f"{AGREEMENT_TARGETS['spearman']}$, $R^2 >= {AGREEMENT_TARGETS['r2']}$. "
                + ("Missed: " + "; ".join(misses) + "." if misses else "All met."))
-    if settings.effects:
-        doc.text(f"Our model here: the section with {effects_text(settings.effects)}. " + verdict + " The knee below "
+    if effects:
+        doc.text(f"Our model here: the section with {effects_text(effects)}. " + verdict + " The knee below "
                  "shows where the shape parts: the uniform 2D section either holds the teeth preloaded or has "
                  "lost them, where the paper's 3D cup loses its engagement gradually.")
     else:

@@ -15,8 +15,7 @@ import pandas as pd
 
 from hdwf import PARAMETER_COLUMNS
 from hdwf.common.io import atomic_path, read_parquet_meta, write_parquet
-from hdwf.drive.design import (MeshSettings, design_parameters, geometry_of, load_drive_mesh, mesh_design,
-                               save_drive_mesh)
+from hdwf.drive.design import (MeshSettings, design_parameters, geometry_of, load_drive_mesh, save_drive_mesh)
 from hdwf.fe import solve_lost_motion
 from hdwf.report.figures import deformed_figure
 from hdwf.study.aggregate import write_lost_motion
@@ -38,13 +37,21 @@ def designs_stage(source: str, unit: str, source_path, data_dir, out, provenance
     return df
 
 
+def _design_model(designs_path, design_id: str, unit: str, effects: Mapping | None):
+    """One design's parameters, the study's switched-on changes (``fe.effects``) and the geometry
+    they shape (the preload thickens the teeth)."""
+    params = design_parameters(designs_path, design_id)
+    changes = model_changes(effects)
+    return params, changes, geometry_of(unit, params, **changes.geometry_part())
+
+
 def mesh_stage(designs_path, design_id: str, unit: str, settings: Mapping, out_msh, out_npz,
                effects: Mapping | None = None) -> dict:
     """Mesh one design: gmsh ``.msh`` for review, ``.npz`` for the solver; returns mesh facts.
 
     ``effects`` are the study's switched-on effects (``fe.effects``): the preload reshapes the outline.
     """
-    geom = geometry_of(unit, design_parameters(designs_path, design_id), **model_changes(effects).geometry_part())
+    _, _, geom = _design_model(designs_path, design_id, unit, effects)
     t0 = time.perf_counter()
     with atomic_path(out_msh) as tmp_msh:
         # gmsh picks the format from the extension, so the temporary name keeps ".msh".
@@ -80,10 +87,9 @@ def aggregate_stage(row_paths, curve_paths, out_lost_motion, out_curves, provena
 def refined_solve_stage(designs_path, design_id: str, unit: str, settings: Mapping, steps_per_ramp: int, out,
                         provenance: dict, effects: Mapping | None = None) -> dict:
     """Mesh and solve one design at another refinement (mesh-convergence runs); one row out."""
-    params = design_parameters(designs_path, design_id)
-    changes = model_changes(effects)
-    row, _ = solve_design(unit, params, mesh_design(unit, params, settings, **changes.geometry_part()), steps_per_ramp,
-                          design_id, changes=changes)
+    params, changes, geom = _design_model(designs_path, design_id, unit, effects)
+    row, _ = solve_design(unit, params, MeshSettings.from_mapping(settings).mesh(geom), steps_per_ramp, design_id,
+                          changes=changes)
     row["refinement"] = float(settings["refinement"])
     write_parquet(pd.DataFrame([row]), out, provenance=provenance, meta={"unit": unit})
     return row
@@ -104,9 +110,7 @@ def convergence_stage(default_lost_motion, other_rows, default_refinement: float
 def deformed_stage(designs_path, design_id: str, unit: str, settings: Mapping, steps_per_ramp: int, out_png,
                    out_npz, provenance: dict, effects: Mapping | None = None) -> dict:
     """Solve one design keeping the displacement fields; picture of the mesh near the major axis."""
-    params = design_parameters(designs_path, design_id)
-    changes = model_changes(effects)
-    geom = geometry_of(unit, params, **changes.geometry_part())
+    _, changes, geom = _design_model(designs_path, design_id, unit, effects)
     mesh = MeshSettings.from_mapping(settings).mesh(geom)
     res = solve_lost_motion(geom, mesh, steps_per_ramp=steps_per_ramp, keep_fields=True, changes=changes)
     if res.status != "ok":
