@@ -15,6 +15,7 @@ Phi = phi + phi'.  The modules, from the bottom up:
 * ``working_set`` and ``friction``: the cached compliance of the working set, and the flank
   law (frictionless or Coulomb) with its own cache and stick/slip state;
 * ``solver``: the active-set contact solver of one load level;
+* ``relinearise``: the tooth and cam rows re-detected at a solved state until they agree;
 * ``model``: ``LostMotionModel``, which assembles the pieces for one design;
 * ``preload``: the preload ramp that mounts preloaded teeth (``interference_m``), and the
   check of the teeth outside the watched zones;

@@ -6,10 +6,12 @@ With a preload (``DriveGeometry.interference_m`` > 0) the teeth are then ramped 
 zero torque (``preload.mount_preloaded``), every tooth watched.  After stage 1 the teeth
 outside the watched zones are checked for overlap (reported, ``overlap_outside_zones_um``).
 Stage 2 builds the tooth rows at the deflected configuration, frees the FS rotation and
-runs the torque sequence.  At +-T every tooth pair is re-detected at the deformed state
-(nonlinear gap); if that finds more than 0.05 um penetration (large twists slide the
-flanks), the pairs near contact are re-paired and re-linearised about that state and the
-level is solved again (``max_penetration_redetected_um`` reports the final check).
+runs the torque sequence.  At +-T the tooth and cam rows are settled at the deformed
+state: re-detected (nonlinear gap) and re-linearised until every pair near contact agrees
+with its linearisation within 0.05 um (``relinearise.settle``; the twist sliding the
+flanks along each other must not leave the gaps of the mounted state, or Phi depends on
+the load path and the mesh), then every tooth pair is re-paired from scratch as an
+independent check (``max_penetration_redetected_um``).
 
 The frictionless FS is indifferent inside the backlash at zero torque; zero-torque steps
 use 1e-3 of the test torque in the direction of the last load (the state an
@@ -22,10 +24,9 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
 
 from hdwf.drive.geometry import ARCMIN, DriveGeometry
 from hdwf.drive.mesh import DriveMesh
@@ -33,11 +34,10 @@ from hdwf.fe.changes import ModelChanges
 from hdwf.fe.contact_rows import ball_rows, cam_rows, fit_rows, tooth_rows
 from hdwf.fe.model import ZONE_DEG, LostMotionModel
 from hdwf.fe.preload import PRELOAD_ZONE_DEG, mount_preloaded, overlap_outside_zones
-from hdwf.fe.solver import TOL_GAP, LevelSolution
+from hdwf.fe.relinearise import GEO_MAX_IT, GEO_TOL, settle
+from hdwf.fe.solver import TOL_GAP, ContactFailure, LevelSolution
 
 ZERO_TORQUE_BIAS = 1e-3  # fraction of the test torque used at the zero-torque steps
-RELIN_TOL = 5e-5         # mm: re-linearise tooth pairs at +-T above 0.05 um re-detected
-RELIN_NEAR = 5e-3        # mm: ... but only those pairs closer than this (the loaded flanks)
 
 
 @dataclass
@@ -222,31 +222,21 @@ def mount_wave_generator(model: LostMotionModel,
 
 
 def redetect_teeth(model: LostMotionModel, torque: float,
-                    level: LevelSolution) -> tuple[LevelSolution, float]:
-    """Independent check at +-T: re-detect every FS/CS pair in the zones at the deformed
-    configuration (nonlinear gap, no candidate threshold).  Large twists slide the flanks
-    along each other; if the linearised pairing then misses more than RELIN_TOL, re-pair
-    and re-linearise the tooth rows about this state and solve the level again.
+                   level: LevelSolution) -> tuple[LevelSolution, float]:
+    """At +-T: the tooth and cam rows settled at the deformed state (re-detected and
+    re-linearised until they equal their linearisation within ``GEO_TOL``,
+    ``relinearise.settle``), then an independent check that re-pairs every tooth node of
+    the zones from scratch (nonlinear gap, no candidate threshold).
 
-    Returns the final level and its re-detected penetration (mm)."""
-    geom = model.geometry
-    for relin in range(4):
-        chk = tooth_rows(model.structure, geom, level.u_watch, np.inf)
-        pen_nl = float(-(chk.g0 + chk.G @ level.u_watch).min())
-        if pen_nl <= RELIN_TOL or relin == 3:
-            break
-        tr = model.rows["tooth"]
-        new = tooth_rows(model.structure, geom, level.u_watch, np.inf, nodes=tr.slave_nodes)
-        # only pairs at or near contact are re-linearised; the open flanks
-        # keep the WG-state pairing, which is the right one for the way back
-        near = (tr.g0 + tr.G @ level.u_watch) < RELIN_NEAR
-        Dn = sp.diags(near.astype(float))
-        Df = sp.diags((~near).astype(float))
-        mixed = replace(tr, G=(Dn @ new.G + Df @ tr.G).tocsr(), g0=np.where(near, new.g0, tr.g0),
-                        slip=(Dn @ new.slip + Df @ tr.slip).tocsr())
-        model.replace_rows("tooth", mixed)
-        level = model.solve_level(torque, level.active)
-    return level, pen_nl
+    Returns the final level and its re-detected penetration (mm); raises ``ContactFailure``
+    if the rows do not settle."""
+    level, err, ok = settle(model, level, torque, GEO_TOL)
+    if not ok:
+        raise ContactFailure(f"torque {torque / 1000:.1f} N m: tooth gaps re-detected "
+                             f"{err * 1000:.3f} um off their linearisation after "
+                             f"{GEO_MAX_IT} re-linearisations")
+    chk = tooth_rows(model.structure, model.geometry, level.u_watch, np.inf)
+    return level, float(-(chk.g0 + chk.G @ level.u_watch).min())
 
 
 def _teeth_in_contact(model: LostMotionModel, level: LevelSolution, kinds: np.ndarray) -> int:
@@ -279,10 +269,12 @@ def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWave
         else:
             T = ZERO_TORQUE_BIAS * Tn * last_sign
         level = model.solve_level(T, active)
-        if abs(abs(fraction) - 1.0) < 1e-12:
+        active = level.active    # the next level's warm start, solved with the rows it will use
+        at_full_torque = abs(abs(fraction) - 1.0) < 1e-12
+        if at_full_torque:
+            mounted_rows = {kind: model.rows[kind] for kind in ("tooth", "cam")}
             level, pen_nl = redetect_teeth(model, T, level)
             maxpen_nl = max(maxpen_nl, pen_nl)
-        active = level.active
         twists.append(level.twist)
         kinds = np.array([i[0] for i in level.pair_ids])
         geo_mask = kinds != "ball"
@@ -291,6 +283,10 @@ def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWave
             if fields is not None and "plus" not in fields:
                 fields["plus"] = model.full_displacements(level, T)
             tooth_count = _teeth_in_contact(model, level, kinds)
+        if at_full_torque:
+            # rows settled at +-T fit that state only: the way back starts from the mount's
+            for kind, rows in mounted_rows.items():
+                model.replace_rows(kind, rows)
     return _TorqueTest(np.array(twists), maxpen, maxpen_nl, tooth_count, fields)
 
 

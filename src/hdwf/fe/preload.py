@@ -11,7 +11,7 @@ of a general FE code does it: every tooth gap is first held back by the largest 
 h0 (nothing penetrates), h is lowered to 0 in steps of at most ``RAMP_STEP_M`` modules,
 and at every step the tooth and cam rows are re-detected at the current deformed state
 and re-linearised until the re-detected gap of every pair near contact equals its
-linearisation to ``GEO_TOL`` (0.05 um).  At h = 0 that is the true gap.  The tooth rows
+linearisation to ``GEO_TOL`` (0.05 um; ``relinearise.settle``).  At h = 0 that is the true gap.  The tooth rows
 keep one slave-node set (every tooth node of the engagement zones), so a pair keeps its
 identity and its cached compliance column is only renewed when its row changed.
 """
@@ -19,82 +19,30 @@ identity and its cached compliance column is only renewed when its row changed.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import numpy as np
-import scipy.sparse as sp
 
 from hdwf.fe.contact_geometry import boundary_edge_normals, closest_segments
-from hdwf.fe.contact_rows import Rows, cam_rows, tooth_rows
+from hdwf.fe.contact_rows import tooth_rows
 from hdwf.fe.model import LostMotionModel
+from hdwf.fe.relinearise import GEO_MAX_IT, GEO_TOL, held_back, settle
 from hdwf.fe.solver import ContactFailure, LevelSolution
 
 RAMP_STEP_M = 0.05   # largest drop of the held-back overlap per ramp step, in modules
-GEO_TOL = 5e-5       # mm: re-detected minus linearised gap of the pairs near contact
-STEP_TOL = 5e-4      # mm: the same at the intermediate ramp steps
-GEO_NEAR = 5e-3      # mm: pairs closer than this count as near contact
-GEO_MAX_IT = 12      # re-linearisations per ramp step
+STEP_TOL = 5e-4      # mm: re-detected minus linearised gap at the intermediate ramp steps
 PRELOAD_ZONE_DEG = 90.0   # a preload engages far more teeth: watch every tooth
 
 
-def _held_back(rows: Rows, hold: float) -> Rows:
-    """The tooth rows with every gap increased by ``hold`` (mm), the overlap not yet ramped in."""
-    return replace(rows, g0=rows.g0 + hold)
-
-
-def _linearisation_error(old: Rows, new: Rows, u: np.ndarray) -> float:
-    """Largest |re-detected - linearised| gap at ``u`` over the pairs near contact (mm)."""
-    g_old, g_new = old.g0 + old.G @ u, new.g0 + new.G @ u
-    near = (g_old < GEO_NEAR) | (g_new < GEO_NEAR)
-    return float(np.abs(g_new - g_old)[near].max()) if near.any() else 0.0
-
-
-def _near_only(old: Rows, new: Rows, u: np.ndarray) -> Rows:
-    """``new`` for the pairs near contact, ``old`` for the rest: a far pair's row is renewed
-    only once it comes near (each renewed row in the working set costs a back-substitution)."""
-    near = ((old.g0 + old.G @ u) < GEO_NEAR) | ((new.g0 + new.G @ u) < GEO_NEAR)
-    Dn, Df = sp.diags(near.astype(float)), sp.diags((~near).astype(float))
-    return replace(new, G=(Dn @ new.G + Df @ old.G).tocsr(), g0=np.where(near, new.g0, old.g0),
-                   slip=(Dn @ new.slip + Df @ old.slip).tocsr())
-
-
-def _gap_only(old: Rows, new: Rows, u: np.ndarray) -> Rows:
-    """``old`` with its gaps moved to the re-detected ones at ``u`` (same G: a modified-Newton
-    update that needs no back-substitution; its fixed point is the true gap)."""
-    return replace(old, g0=old.g0 + (new.g0 + new.G @ u) - (old.g0 + old.G @ u))
-
-
-def _settle(model: LostMotionModel, nodes: tuple, hold: float, level: LevelSolution,
-            tol: float) -> tuple[LevelSolution, float]:
-    """Solve one ramp step with the tooth and cam gaps re-detected at the solution until
-    they equal their linearisations within ``tol``; returns the level and that error.
-
-    Only the gaps are moved to the re-detected ones (no back-substitution) as long as that
-    halves the error; when it stops doing so the pairs near contact are re-linearised (new
-    normals and segments, new columns).  The torque stage re-linearises the loaded pairs
-    again at +-T (``cycle.redetect_teeth``)."""
-    st, geom = model.structure, model.geometry
-    err, prev = math.inf, math.inf
-    for _ in range(GEO_MAX_IT):
-        level = model.solve_level(0.0, level.active)
-        u = level.u_watch
-        tooth = _held_back(tooth_rows(st, geom, u, np.inf, nodes=nodes), hold)
-        cam = cam_rows(st, geom, u)
-        err = max(_linearisation_error(model.rows["tooth"], tooth, u),
-                  _linearisation_error(model.rows["cam"], cam, u))
-        if err < tol:
-            return level, err
-        fresh = err > 0.5 * prev     # the gap updates stopped contracting
-        prev = err
-        if fresh:
-            model.replace_rows("tooth", _near_only(model.rows["tooth"], tooth, u))
-            model.replace_rows("cam", cam)
-        else:
-            model.rows["tooth"] = _gap_only(model.rows["tooth"], tooth, u)
-            model.rows["cam"] = _gap_only(model.rows["cam"], cam, u)
-    raise ContactFailure(f"preload ramp: tooth gaps re-detected {err * 1000:.3f} um off their "
-                         f"linearisation after {GEO_MAX_IT} re-linearisations "
-                         f"(held-back overlap {hold * 1000:.2f} um)")
+def _ramp_step(model: LostMotionModel, level: LevelSolution, hold: float, tol: float
+               ) -> tuple[LevelSolution, float]:
+    """Solve one ramp step (held-back overlap ``hold``) and settle its gaps to ``tol``."""
+    level = model.solve_level(0.0, level.active)
+    level, err, ok = settle(model, level, 0.0, tol, hold)
+    if not ok:
+        raise ContactFailure(f"preload ramp: tooth gaps re-detected {err * 1000:.3f} um off their "
+                             f"linearisation after {GEO_MAX_IT} re-linearisations "
+                             f"(held-back overlap {hold * 1000:.2f} um)")
+    return level, err
 
 
 def mount_preloaded(model: LostMotionModel, level: LevelSolution) -> tuple[LevelSolution, dict]:
@@ -124,17 +72,17 @@ def mount_preloaded(model: LostMotionModel, level: LevelSolution) -> tuple[Level
     nodes = rows.slave_nodes
     overlap = max(0.0, float(-(rows.g0 + rows.G @ u).min()))
     steps = max(1, math.ceil(overlap / (RAMP_STEP_M * geom.module)))
-    model.rows["tooth"] = _held_back(rows, overlap)
+    model.rows["tooth"] = held_back(rows, overlap)
     err, hold = 0.0, overlap
     for k in range(1, steps + 1) if overlap > 0 else ():
         # lower the hold on the current rows (same G: nothing to back-substitute)
         new_hold = overlap * (1.0 - k / steps)
-        model.rows["tooth"] = _held_back(model.rows["tooth"], new_hold - hold)
+        model.rows["tooth"] = held_back(model.rows["tooth"], new_hold - hold)
         hold = new_hold
         # intermediate steps only have to keep the ramp on its path; the last one is exact
-        level, err = _settle(model, nodes, hold, level, GEO_TOL if k == steps else STEP_TOL)
+        level, err = _ramp_step(model, level, hold, GEO_TOL if k == steps else STEP_TOL)
     if overlap <= 0:     # no tooth overlaps: one solve with the tooth rows in (true gaps)
-        level, err = _settle(model, nodes, 0.0, level, GEO_TOL)
+        level, err = _ramp_step(model, level, 0.0, GEO_TOL)
     check = tooth_rows(st, geom, level.u_watch, np.inf, nodes=nodes)
     pen = max(0.0, float(-(check.g0 + check.G @ level.u_watch).min()))
     if pen > GEO_TOL + model.solver.settings.tol_gap:

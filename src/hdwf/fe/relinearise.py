@@ -1,0 +1,108 @@
+"""The tooth and cam rows brought to a solved state: re-detected and re-linearised until they agree.
+
+Contact rows are linear in the displacement about the configuration where they were built.
+A state reached by sliding the flanks along each other (the preload ramp pushing the FS
+out of the CS spaces, the FS turned at +-T) has to be solved again with rows that match it,
+or its gaps are off by fractions of a micrometre.  With preloaded teeth that is not small:
+the twist at +-T is the difference of the interference and the elastic retreat of the FS,
+and a single re-linearisation at +T made Phi path-dependent (the way back to zero did not
+return to the start) and jump from mesh to mesh (``docs/fe-model.md``).
+
+``settle`` is the fixed point: at a solved level the rows of every pair near contact are
+re-detected (nonlinear gap) and compared with their linearisation; while the error is above
+the tolerance the gaps are moved to the re-detected ones (a modified-Newton step that needs
+no back-substitution) as long as that halves the error, and otherwise the pairs near
+contact are re-paired and re-linearised (new normals and segments).  Its fixed point is the
+true gap at the solution.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import scipy.sparse as sp
+
+from hdwf.fe.contact_rows import Rows, cam_rows, tooth_rows
+from hdwf.fe.model import LostMotionModel
+from hdwf.fe.solver import LevelSolution
+
+GEO_TOL = 5e-5       # mm: re-detected minus linearised gap of the pairs near contact
+GEO_NEAR = 5e-3      # mm: pairs closer than this count as near contact
+GEO_MAX_IT = 12      # re-linearisations per state
+
+
+def held_back(rows: Rows, hold: float) -> Rows:
+    """The tooth rows with every gap increased by ``hold`` (mm), an overlap not yet ramped in."""
+    return replace(rows, g0=rows.g0 + hold)
+
+
+def linearisation_error(old: Rows, new: Rows, u: np.ndarray) -> float:
+    """Largest |re-detected - linearised| gap at ``u`` over the pairs near contact (mm)."""
+    g_old, g_new = old.g0 + old.G @ u, new.g0 + new.G @ u
+    near = (g_old < GEO_NEAR) | (g_new < GEO_NEAR)
+    return float(np.abs(g_new - g_old)[near].max()) if near.any() else 0.0
+
+
+def near_only(old: Rows, new: Rows, u: np.ndarray) -> Rows:
+    """``new`` for the pairs near contact, ``old`` for the rest: a far pair's row is renewed
+    only once it comes near (each renewed row in the working set costs a back-substitution)."""
+    near = ((old.g0 + old.G @ u) < GEO_NEAR) | ((new.g0 + new.G @ u) < GEO_NEAR)
+    Dn, Df = sp.diags(near.astype(float)), sp.diags((~near).astype(float))
+    return replace(new, G=(Dn @ new.G + Df @ old.G).tocsr(), g0=np.where(near, new.g0, old.g0),
+                   slip=(Dn @ new.slip + Df @ old.slip).tocsr())
+
+
+def gap_only(old: Rows, new: Rows, u: np.ndarray) -> Rows:
+    """``old`` with its gaps moved to the re-detected ones at ``u`` (same G: a modified-Newton
+    update that needs no back-substitution; its fixed point is the true gap)."""
+    return replace(old, g0=old.g0 + (new.g0 + new.G @ u) - (old.g0 + old.G @ u))
+
+
+def settle(model: LostMotionModel, level: LevelSolution, torque: float, tol: float,
+           hold: float = 0.0) -> tuple[LevelSolution, float, bool]:
+    """Re-solve ``level`` (the solution of the model's current rows at ``torque``, N mm)
+    with the tooth and cam rows re-detected at the solution until they equal their
+    linearisations within ``tol`` (mm).
+
+    The tooth rows keep their slave nodes, so a pair keeps its identity (and its cached
+    compliance column while its row is unchanged); ``hold`` (mm) is added to every
+    re-detected tooth gap (the preload ramp's overlap not yet ramped in).
+
+    Returns
+    -------
+    LevelSolution
+        The last solution.
+    float
+        Its linearisation error (mm).
+    bool
+        Whether that is within ``tol`` (after at most ``GEO_MAX_IT`` updates).
+    """
+    tooth, cam, err = _redetect(model, level.u_watch, hold)
+    prev = math.inf
+    for _ in range(GEO_MAX_IT):
+        if err < tol:
+            break
+        u = level.u_watch
+        if err > 0.5 * prev:     # the gap updates stopped contracting: re-linearise
+            model.replace_rows("tooth", near_only(model.rows["tooth"], tooth, u))
+            model.replace_rows("cam", cam)
+        else:
+            model.rows["tooth"] = gap_only(model.rows["tooth"], tooth, u)
+            model.rows["cam"] = gap_only(model.rows["cam"], cam, u)
+        prev = err
+        level = model.solve_level(torque, level.active)
+        tooth, cam, err = _redetect(model, level.u_watch, hold)
+    return level, err, err < tol
+
+
+def _redetect(model: LostMotionModel, u: np.ndarray, hold: float) -> tuple[Rows, Rows, float]:
+    """Tooth (same slave nodes, held back by ``hold``) and cam rows re-detected at ``u``, and
+    the largest difference from the current rows' linearisation there (mm)."""
+    st, geom = model.structure, model.geometry
+    tooth = held_back(tooth_rows(st, geom, u, np.inf, nodes=model.rows["tooth"].slave_nodes), hold)
+    cam = cam_rows(st, geom, u)
+    err = max(linearisation_error(model.rows["tooth"], tooth, u),
+              linearisation_error(model.rows["cam"], cam, u))
+    return tooth, cam, err
