@@ -9,6 +9,8 @@ rule doe:
         n=config["doe"]["n_designs"],
         seed=config["doe"]["seed"],
         optimization=config["doe"]["optimization"],
+    benchmark:
+        "results/benchmarks/doe_{unit}.tsv"
     log:
         "results/logs/doe_{unit}.log",
     script:

@@ -10,6 +10,8 @@ rule fe_designs:
         study=_alternatives(FE_STUDIES),
     params:
         designs=lambda w: STUDIES[w.study]["designs"],
+    benchmark:
+        "results/benchmarks/{study}_{unit}_designs.tsv"
     log:
         "results/logs/{study}_{unit}_designs.log",
     script:
@@ -26,6 +28,8 @@ rule fe_mesh:
         settings={k: FE[k] for k in ("elements_over_height", "elements_over_thickness", "refinement", "symmetry")},
         effects=FE["effects"],
     threads: 1
+    benchmark:
+        "results/benchmarks/{study}_{unit}_mesh_{design}.tsv"
     log:
         "results/logs/{study}_{unit}_mesh_{design}.log",
     script:
@@ -68,6 +72,8 @@ rule fe_aggregate:
     params:
         effects=FE["effects"],
         calibrated_on=FE.get("calibrated_on"),
+    benchmark:
+        "results/benchmarks/{study}_{unit}_aggregate.tsv"
     log:
         "results/logs/{study}_{unit}_aggregate.log",
     script:
@@ -89,6 +95,8 @@ rule fe_refined_solve:
     threads: 1
     resources:
         mem_mb=4000,
+    benchmark:
+        "results/benchmarks/{study}_{unit}_convergence_r{ref}_{design}.tsv"
     log:
         "results/logs/{study}_{unit}_convergence_r{ref}_{design}.log",
     script:
@@ -104,6 +112,8 @@ rule fe_convergence:
         study=_alternatives(FE_STUDIES),
     params:
         refinement=FE["refinement"],
+    benchmark:
+        "results/benchmarks/{study}_{unit}_convergence.tsv"
     log:
         "results/logs/{study}_{unit}_convergence.log",
     script:
@@ -123,6 +133,8 @@ rule fe_deformed:
         steps_per_ramp=FE["steps_per_ramp"],
         effects=FE["effects"],
     threads: 1
+    benchmark:
+        "results/benchmarks/{study}_{unit}_deformed_{design}.tsv"
     log:
         "results/logs/{study}_{unit}_deformed_{design}.log",
     script:

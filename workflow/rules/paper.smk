@@ -7,6 +7,8 @@ rule paper_lost_motion:
         "results/{study}/{unit}/lost_motion.parquet",
     wildcard_constraints:
         study=_alternatives(PAPER_STUDIES),
+    benchmark:
+        "results/benchmarks/{study}_{unit}_lost_motion.tsv"
     log:
         "results/logs/{study}_{unit}_lost_motion.log",
     script:

@@ -11,6 +11,8 @@ rule study_report:
     params:
         owners=lambda w: study_report_files(w)[1],
         study_config=lambda w: STUDIES[w.study],
+    benchmark:
+        "results/benchmarks/{study}_report.tsv"
     log:
         "results/logs/{study}_report.log",
     script:
@@ -27,6 +29,8 @@ rule full_report:
         owners=lambda w: full_report_files()[1],
         studies=STUDIES,
         fe_settings={k: v for k, v in FE.items() if k not in ("convergence", "picture")},
+    benchmark:
+        "results/benchmarks/report.tsv"
     log:
         "results/logs/report.log",
     script:

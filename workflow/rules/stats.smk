@@ -7,6 +7,8 @@ rule correlation:
         table="results/{study}/{unit}/correlation.parquet",
         figure=report("results/{study}/{unit}/correlation.png", caption="../report/correlation.rst",
                       category="{study}", subcategory="{unit}"),
+    benchmark:
+        "results/benchmarks/{study}_{unit}_correlation.tsv"
     log:
         "results/logs/{study}_{unit}_correlation.log",
     script:
@@ -23,6 +25,8 @@ rule surrogate:
                       category="{study}", subcategory="{unit}"),
     params:
         bounds_source=lambda w: STUDIES[w.study]["surrogate_bounds"],
+    benchmark:
+        "results/benchmarks/{study}_{unit}_surrogate.tsv"
     log:
         "results/logs/{study}_{unit}_surrogate.log",
     script:
@@ -40,6 +44,8 @@ rule sobol:
     params:
         settings={k: v for k, v in config["sobol"].items() if k != "samplers"},
         samplers=config["sobol"]["samplers"],
+    benchmark:
+        "results/benchmarks/{study}_{unit}_sobol.tsv"
     log:
         "results/logs/{study}_{unit}_sobol.log",
     script:

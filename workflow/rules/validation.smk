@@ -85,6 +85,8 @@ rule validation_figures:
                          category="validation", subcategory="{campaign}"),
         ladder=report("results/validation/{campaign}/ladder.png", caption="../report/validation.rst",
                       category="validation", subcategory="{campaign}"),
+    benchmark:
+        "results/benchmarks/validation_{campaign}_figures.tsv"
     log:
         "results/logs/validation_{campaign}_figures.log",
     script:
