@@ -11,7 +11,8 @@ state: re-detected (nonlinear gap) and re-linearised until every pair near conta
 with its linearisation within 0.05 um (``relinearise.settle``; the twist sliding the
 flanks along each other must not leave the gaps of the mounted state, or Phi depends on
 the load path and the mesh), then every tooth pair is re-paired from scratch as an
-independent check (``max_penetration_redetected_um``).
+independent check (``max_penetration_redetected_um``).  The way back starts from the mount's
+rows again: rows settled at +T fit that state only.
 
 The frictionless FS is indifferent inside the backlash at zero torque; zero-torque steps
 use 1e-3 of the test torque in the direction of the last load (the state an
