@@ -271,10 +271,13 @@ def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWave
             T = ZERO_TORQUE_BIAS * Tn * last_sign
         level = model.solve_level(T, active)
         active = level.active    # the next level's warm start, solved with the rows it will use
-        at_full_torque = abs(abs(fraction) - 1.0) < 1e-12
-        if at_full_torque:
-            mounted_rows = {kind: model.rows[kind] for kind in ("tooth", "cam")}
-            level, pen_nl = redetect_teeth(model, T, level)
+        at = model
+        if abs(abs(fraction) - 1.0) < 1e-12:
+            # rows settled at +-T fit that state only: settled on a fork, so the way back
+            # starts from the mount's rows (and their compliance columns) again
+            at = model.fork()
+            level, pen_nl = redetect_teeth(at, T, level)
+            model.solver.iterations = at.solver.iterations   # the count includes the settling
             maxpen_nl = max(maxpen_nl, pen_nl)
         twists.append(level.twist)
         kinds = np.array([i[0] for i in level.pair_ids])
@@ -282,12 +285,8 @@ def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWave
         maxpen = max(maxpen, float(-(level.gap[geo_mask]).min()))
         if abs(fraction - 1.0) < 1e-12:
             if fields is not None and "plus" not in fields:
-                fields["plus"] = model.full_displacements(level, T)
-            tooth_count = _teeth_in_contact(model, level, kinds)
-        if at_full_torque:
-            # rows settled at +-T fit that state only: the way back starts from the mount's
-            for kind, rows in mounted_rows.items():
-                model.replace_rows(kind, rows)
+                fields["plus"] = at.full_displacements(level, T)
+            tooth_count = _teeth_in_contact(at, level, kinds)
     return _TorqueTest(np.array(twists), maxpen, maxpen_nl, tooth_count, fields)
 
 
