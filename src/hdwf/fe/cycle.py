@@ -6,13 +6,15 @@ With a preload (``DriveGeometry.interference_m`` > 0) the teeth are then ramped 
 zero torque (``preload.mount_preloaded``), every tooth watched.  After stage 1 the teeth
 outside the watched zones are checked for overlap (reported, ``overlap_outside_zones_um``).
 Stage 2 builds the tooth rows at the deflected configuration, frees the FS rotation and
-runs the torque sequence.  At +-T the tooth and cam rows are settled at the deformed
-state: re-detected (nonlinear gap) and re-linearised until every pair near contact agrees
+runs the torque sequence.  At +-T, with preloaded teeth, the tooth and cam rows are settled
+at the deformed state: re-detected (nonlinear gap) and re-linearised until every pair near contact agrees
 with its linearisation within 0.05 um (``relinearise.settle``; the twist sliding the
 flanks along each other must not leave the gaps of the mounted state, or Phi depends on
 the load path and the mesh), then every tooth pair is re-paired from scratch as an
 independent check (``max_penetration_redetected_um``).  The way back starts from the mount's
-rows again: rows settled at +T fit that state only.
+rows again: rows settled at +T fit that state only.  Without preload (and in the coning
+slices) the near pairs are re-linearised once at +-T if more than 0.05 um penetration is
+re-detected, and those rows are kept for the way back (``redetect_teeth``).
 
 The frictionless FS is indifferent inside the backlash at zero torque; zero-torque steps
 use 1e-3 of the test torque in the direction of the last load (the state an
@@ -25,9 +27,10 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
+import scipy.sparse as sp
 
 from hdwf.drive.geometry import ARCMIN, DriveGeometry
 from hdwf.drive.mesh import DriveMesh
@@ -39,6 +42,8 @@ from hdwf.fe.relinearise import GEO_MAX_IT, GEO_TOL, settle
 from hdwf.fe.solver import TOL_GAP, ContactFailure, LevelSolution
 
 ZERO_TORQUE_BIAS = 1e-3  # fraction of the test torque used at the zero-torque steps
+RELIN_TOL = 5e-5         # mm: re-linearise tooth pairs at +-T above 0.05 um re-detected
+RELIN_NEAR = 5e-3        # mm: ... but only those pairs closer than this (the loaded flanks)
 
 
 @dataclass
@@ -223,8 +228,36 @@ def mount_wave_generator(model: LostMotionModel,
 
 
 def redetect_teeth(model: LostMotionModel, torque: float,
-                   level: LevelSolution) -> tuple[LevelSolution, float]:
-    """At +-T: the tooth and cam rows settled at the deformed state (re-detected and
+                    level: LevelSolution) -> tuple[LevelSolution, float]:
+    """Independent check at +-T: re-detect every FS/CS pair in the zones at the deformed
+    configuration (nonlinear gap, no candidate threshold).  Large twists slide the flanks
+    along each other; if the linearised pairing then misses more than RELIN_TOL, re-pair
+    and re-linearise the tooth rows about this state and solve the level again.
+
+    Returns the final level and its re-detected penetration (mm)."""
+    geom = model.geometry
+    for relin in range(4):
+        chk = tooth_rows(model.structure, geom, level.u_watch, np.inf)
+        pen_nl = float(-(chk.g0 + chk.G @ level.u_watch).min())
+        if pen_nl <= RELIN_TOL or relin == 3:
+            break
+        tr = model.rows["tooth"]
+        new = tooth_rows(model.structure, geom, level.u_watch, np.inf, nodes=tr.slave_nodes)
+        # only pairs at or near contact are re-linearised; the open flanks
+        # keep the WG-state pairing, which is the right one for the way back
+        near = (tr.g0 + tr.G @ level.u_watch) < RELIN_NEAR
+        Dn = sp.diags(near.astype(float))
+        Df = sp.diags((~near).astype(float))
+        mixed = replace(tr, G=(Dn @ new.G + Df @ tr.G).tocsr(), g0=np.where(near, new.g0, tr.g0),
+                        slip=(Dn @ new.slip + Df @ tr.slip).tocsr())
+        model.replace_rows("tooth", mixed)
+        level = model.solve_level(torque, level.active)
+    return level, pen_nl
+
+
+def settle_teeth(model: LostMotionModel, torque: float,
+                 level: LevelSolution) -> tuple[LevelSolution, float]:
+    """At +-T (preloaded teeth): the tooth and cam rows settled at the deformed state (re-detected and
     re-linearised until they equal their linearisation within ``GEO_TOL``,
     ``relinearise.settle``), then an independent check that re-pairs every tooth node of
     the zones from scratch (nonlinear gap, no candidate threshold).
@@ -272,12 +305,16 @@ def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWave
         level = model.solve_level(T, active)
         active = level.active    # the next level's warm start, solved with the rows it will use
         at = model
-        if abs(abs(fraction) - 1.0) < 1e-12:
-            # rows settled at +-T fit that state only: settled on a fork, so the way back
-            # starts from the mount's rows (and their compliance columns) again
+        if abs(abs(fraction) - 1.0) < 1e-12 and model.geometry.interference_m > 0:
+            # preloaded: rows settled at +-T fit that state only, so they are settled on a
+            # fork and the way back starts from the mount's rows (and columns) again
             at = model.fork()
-            level, pen_nl = redetect_teeth(at, T, level)
+            level, pen_nl = settle_teeth(at, T, level)
             model.solver.iterations = at.solver.iterations   # the count includes the settling
+            maxpen_nl = max(maxpen_nl, pen_nl)
+        elif abs(abs(fraction) - 1.0) < 1e-12:
+            level, pen_nl = redetect_teeth(model, T, level)
+            active = level.active
             maxpen_nl = max(maxpen_nl, pen_nl)
         twists.append(level.twist)
         kinds = np.array([i[0] for i in level.pair_ids])
