@@ -25,7 +25,7 @@ T = (1/N) sum_j T'_j(theta), T'_j the full section's torque-twist relation at pu
 Why combining curves is exact for our Phi.  ``cycle`` defines Phi = theta(+T) - theta(-T)
 (the twists at +-T minus the first state's, which cancels).  Frictionless contact is
 elastic and path independent: the state at a torque does not depend on the levels before
-it (up to the re-linearisation of the tooth rows at a state, ``cycle.redetect_teeth``).
+it (up to the re-linearisation of the tooth rows at a state, ``relinearise.redetect_teeth``).
 So theta(+-T) of the slices in parallel is found from each slice's twist-torque relation
 alone: sample it, invert the summed monotone relation mean_j T'_j(theta) = +-T, then solve
 every slice at its share T'_j* and insert that point (``refine``) until every slice's
@@ -49,7 +49,8 @@ import numpy as np
 
 from hdwf.drive.geometry import ARCMIN, DriveGeometry, size_cam
 from hdwf.drive.mesh import DriveMesh
-from hdwf.fe.cycle import ZERO_TORQUE_BIAS, mount_wave_generator, redetect_teeth
+from hdwf.fe.cycle import ZERO_TORQUE_BIAS, mount_wave_generator
+from hdwf.fe.relinearise import redetect_teeth
 from hdwf.fe.model import LostMotionModel
 from hdwf.fe.preload import PRELOAD_ZONE_DEG
 from hdwf.fe.solver import ContactFailure

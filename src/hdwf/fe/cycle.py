@@ -27,10 +27,9 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
 
 from hdwf.drive.geometry import ARCMIN, DriveGeometry
 from hdwf.drive.mesh import DriveMesh
@@ -38,12 +37,10 @@ from hdwf.fe.changes import ModelChanges
 from hdwf.fe.contact_rows import ball_rows, cam_rows, fit_rows, tooth_rows
 from hdwf.fe.model import ZONE_DEG, LostMotionModel
 from hdwf.fe.preload import PRELOAD_ZONE_DEG, mount_preloaded, overlap_outside_zones
-from hdwf.fe.relinearise import GEO_MAX_IT, GEO_TOL, settle
-from hdwf.fe.solver import TOL_GAP, ContactFailure, LevelSolution
+from hdwf.fe.relinearise import redetect_teeth, settle_teeth
+from hdwf.fe.solver import TOL_GAP, LevelSolution
 
 ZERO_TORQUE_BIAS = 1e-3  # fraction of the test torque used at the zero-torque steps
-RELIN_TOL = 5e-5         # mm: re-linearise tooth pairs at +-T above 0.05 um re-detected
-RELIN_NEAR = 5e-3        # mm: ... but only those pairs closer than this (the loaded flanks)
 
 
 @dataclass
@@ -225,52 +222,6 @@ def mount_wave_generator(model: LostMotionModel,
         preload["wg_retreat_um"] = (free_deflection - float(u[j0])) * 1000.0
     return _MountedWaveGenerator(state, float(u[j0]) * 1000.0, preload,
                                  overlap_outside_zones(model, state) * 1000.0)
-
-
-def redetect_teeth(model: LostMotionModel, torque: float,
-                    level: LevelSolution) -> tuple[LevelSolution, float]:
-    """Independent check at +-T: re-detect every FS/CS pair in the zones at the deformed
-    configuration (nonlinear gap, no candidate threshold).  Large twists slide the flanks
-    along each other; if the linearised pairing then misses more than RELIN_TOL, re-pair
-    and re-linearise the tooth rows about this state and solve the level again.
-
-    Returns the final level and its re-detected penetration (mm)."""
-    geom = model.geometry
-    for relin in range(4):
-        chk = tooth_rows(model.structure, geom, level.u_watch, np.inf)
-        pen_nl = float(-(chk.g0 + chk.G @ level.u_watch).min())
-        if pen_nl <= RELIN_TOL or relin == 3:
-            break
-        tr = model.rows["tooth"]
-        new = tooth_rows(model.structure, geom, level.u_watch, np.inf, nodes=tr.slave_nodes)
-        # only pairs at or near contact are re-linearised; the open flanks
-        # keep the WG-state pairing, which is the right one for the way back
-        near = (tr.g0 + tr.G @ level.u_watch) < RELIN_NEAR
-        Dn = sp.diags(near.astype(float))
-        Df = sp.diags((~near).astype(float))
-        mixed = replace(tr, G=(Dn @ new.G + Df @ tr.G).tocsr(), g0=np.where(near, new.g0, tr.g0),
-                        slip=(Dn @ new.slip + Df @ tr.slip).tocsr())
-        model.replace_rows("tooth", mixed)
-        level = model.solve_level(torque, level.active)
-    return level, pen_nl
-
-
-def settle_teeth(model: LostMotionModel, torque: float,
-                 level: LevelSolution) -> tuple[LevelSolution, float]:
-    """At +-T (preloaded teeth): the tooth and cam rows settled at the deformed state (re-detected and
-    re-linearised until they equal their linearisation within ``GEO_TOL``,
-    ``relinearise.settle``), then an independent check that re-pairs every tooth node of
-    the zones from scratch (nonlinear gap, no candidate threshold).
-
-    Returns the final level and its re-detected penetration (mm); raises ``ContactFailure``
-    if the rows do not settle."""
-    level, err, ok = settle(model, level, torque, GEO_TOL)
-    if not ok:
-        raise ContactFailure(f"torque {torque / 1000:.1f} N m: tooth gaps re-detected "
-                             f"{err * 1000:.3f} um off their linearisation after "
-                             f"{GEO_MAX_IT} re-linearisations")
-    chk = tooth_rows(model.structure, model.geometry, level.u_watch, np.inf)
-    return level, float(-(chk.g0 + chk.G @ level.u_watch).min())
 
 
 def _teeth_in_contact(model: LostMotionModel, level: LevelSolution, kinds: np.ndarray) -> int:

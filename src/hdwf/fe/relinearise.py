@@ -13,7 +13,8 @@ re-detected (nonlinear gap) and compared with their linearisation; while the err
 the tolerance the gaps are moved to the re-detected ones (a modified-Newton step that needs
 no back-substitution) as long as that halves the error, and otherwise the pairs near
 contact are re-paired and re-linearised (new normals and segments).  Its fixed point is the
-true gap at the solution.
+true gap at the solution.  ``settle_teeth`` applies it at +-T with preloaded teeth;
+``redetect_teeth`` is the single re-linearisation the bare section and the coning slices keep.
 """
 
 from __future__ import annotations
@@ -26,11 +27,13 @@ import scipy.sparse as sp
 
 from hdwf.fe.contact_rows import Rows, cam_rows, tooth_rows
 from hdwf.fe.model import LostMotionModel
-from hdwf.fe.solver import LevelSolution
+from hdwf.fe.solver import ContactFailure, LevelSolution
 
 GEO_TOL = 5e-5       # mm: re-detected minus linearised gap of the pairs near contact
 GEO_NEAR = 5e-3      # mm: pairs closer than this count as near contact
 GEO_MAX_IT = 12      # re-linearisations per state
+RELIN_TOL = 5e-5     # mm: without preload, re-linearise tooth pairs at +-T above 0.05 um re-detected
+RELIN_NEAR = 5e-3    # mm: ... but only those pairs closer than this (the loaded flanks)
 
 
 def held_back(rows: Rows, hold: float) -> Rows:
@@ -106,3 +109,49 @@ def _redetect(model: LostMotionModel, u: np.ndarray, hold: float) -> tuple[Rows,
     err = max(linearisation_error(model.rows["tooth"], tooth, u),
               linearisation_error(model.rows["cam"], cam, u))
     return tooth, cam, err
+
+
+def settle_teeth(model: LostMotionModel, torque: float,
+                 level: LevelSolution) -> tuple[LevelSolution, float]:
+    """At +-T (preloaded teeth): the tooth and cam rows settled at the deformed state (re-detected and
+    re-linearised until they equal their linearisation within ``GEO_TOL``,
+    ``relinearise.settle``), then an independent check that re-pairs every tooth node of
+    the zones from scratch (nonlinear gap, no candidate threshold).
+
+    Returns the final level and its re-detected penetration (mm); raises ``ContactFailure``
+    if the rows do not settle."""
+    level, err, ok = settle(model, level, torque, GEO_TOL)
+    if not ok:
+        raise ContactFailure(f"torque {torque / 1000:.1f} N m: tooth gaps re-detected "
+                             f"{err * 1000:.3f} um off their linearisation after "
+                             f"{GEO_MAX_IT} re-linearisations")
+    chk = tooth_rows(model.structure, model.geometry, level.u_watch, np.inf)
+    return level, float(-(chk.g0 + chk.G @ level.u_watch).min())
+
+
+def redetect_teeth(model: LostMotionModel, torque: float,
+                    level: LevelSolution) -> tuple[LevelSolution, float]:
+    """Independent check at +-T: re-detect every FS/CS pair in the zones at the deformed
+    configuration (nonlinear gap, no candidate threshold).  Large twists slide the flanks
+    along each other; if the linearised pairing then misses more than RELIN_TOL, re-pair
+    and re-linearise the tooth rows about this state and solve the level again.
+
+    Returns the final level and its re-detected penetration (mm)."""
+    geom = model.geometry
+    for relin in range(4):
+        chk = tooth_rows(model.structure, geom, level.u_watch, np.inf)
+        pen_nl = float(-(chk.g0 + chk.G @ level.u_watch).min())
+        if pen_nl <= RELIN_TOL or relin == 3:
+            break
+        tr = model.rows["tooth"]
+        new = tooth_rows(model.structure, geom, level.u_watch, np.inf, nodes=tr.slave_nodes)
+        # only pairs at or near contact are re-linearised; the open flanks
+        # keep the WG-state pairing, which is the right one for the way back
+        near = (tr.g0 + tr.G @ level.u_watch) < RELIN_NEAR
+        Dn = sp.diags(near.astype(float))
+        Df = sp.diags((~near).astype(float))
+        mixed = replace(tr, G=(Dn @ new.G + Df @ tr.G).tocsr(), g0=np.where(near, new.g0, tr.g0),
+                        slip=(Dn @ new.slip + Df @ tr.slip).tocsr())
+        model.replace_rows("tooth", mixed)
+        level = model.solve_level(torque, level.active)
+    return level, pen_nl
