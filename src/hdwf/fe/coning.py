@@ -50,9 +50,9 @@ import numpy as np
 from hdwf.drive.geometry import ARCMIN, DriveGeometry, size_cam
 from hdwf.drive.mesh import DriveMesh
 from hdwf.fe.cycle import ZERO_TORQUE_BIAS, mount_wave_generator
-from hdwf.fe.relinearise import redetect_teeth
 from hdwf.fe.model import LostMotionModel
 from hdwf.fe.preload import PRELOAD_ZONE_DEG
+from hdwf.fe.relinearise import redetect_teeth
 from hdwf.fe.solver import ContactFailure
 
 # torques first sampled on each slice's curve, as multiples of the test torque (each side);

@@ -7,8 +7,8 @@ zero torque (``preload.mount_preloaded``), every tooth watched.  After stage 1 t
 outside the watched zones are checked for overlap (reported, ``overlap_outside_zones_um``).
 Stage 2 builds the tooth rows at the deflected configuration, frees the FS rotation and
 runs the torque sequence.  At +-T, with preloaded teeth, the tooth and cam rows are settled
-at the deformed state: re-detected (nonlinear gap) and re-linearised until every pair near contact agrees
-with its linearisation within 0.05 um (``relinearise.settle``; the twist sliding the
+at the deformed state: re-detected (nonlinear gap) and re-linearised until every pair near
+contact agrees with its linearisation within 0.05 um (``relinearise.settle``; the twist sliding the
 flanks along each other must not leave the gaps of the mounted state, or Phi depends on
 the load path and the mesh), then every tooth pair is re-paired from scratch as an
 independent check (``max_penetration_redetected_um``).  The way back starts from the mount's
@@ -256,14 +256,15 @@ def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWave
         level = model.solve_level(T, active)
         active = level.active    # the next level's warm start, solved with the rows it will use
         at = model
-        if abs(abs(fraction) - 1.0) < 1e-12 and model.geometry.interference_m > 0:
+        at_full_torque = abs(abs(fraction) - 1.0) < 1e-12
+        if at_full_torque and model.geometry.interference_m > 0:
             # preloaded: rows settled at +-T fit that state only, so they are settled on a
             # fork and the way back starts from the mount's rows (and columns) again
             at = model.fork()
             level, pen_nl = settle_teeth(at, T, level)
             model.solver.iterations = at.solver.iterations   # the count includes the settling
             maxpen_nl = max(maxpen_nl, pen_nl)
-        elif abs(abs(fraction) - 1.0) < 1e-12:
+        elif at_full_torque:
             level, pen_nl = redetect_teeth(model, T, level)
             active = level.active
             maxpen_nl = max(maxpen_nl, pen_nl)

@@ -11,9 +11,10 @@ of a general FE code does it: every tooth gap is first held back by the largest 
 h0 (nothing penetrates), h is lowered to 0 in steps of at most ``RAMP_STEP_M`` modules,
 and at every step the tooth and cam rows are re-detected at the current deformed state
 and re-linearised until the re-detected gap of every pair near contact equals its
-linearisation to ``GEO_TOL`` (0.05 um; ``relinearise.settle``).  At h = 0 that is the true gap.  The tooth rows
-keep one slave-node set (every tooth node of the engagement zones), so a pair keeps its
-identity and its cached compliance column is only renewed when its row changed.
+linearisation to ``GEO_TOL`` (0.05 um; ``relinearise.settle``).  At h = 0 that is the true
+gap.  The tooth rows keep one slave-node set (every tooth node of the engagement zones), so
+a pair keeps its identity and its cached compliance column is only renewed when its row
+changed.
 """
 
 from __future__ import annotations

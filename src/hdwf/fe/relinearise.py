@@ -32,8 +32,6 @@ from hdwf.fe.solver import ContactFailure, LevelSolution
 GEO_TOL = 5e-5       # mm: re-detected minus linearised gap of the pairs near contact
 GEO_NEAR = 5e-3      # mm: pairs closer than this count as near contact
 GEO_MAX_IT = 12      # re-linearisations per state
-RELIN_TOL = 5e-5     # mm: without preload, re-linearise tooth pairs at +-T above 0.05 um re-detected
-RELIN_NEAR = 5e-3    # mm: ... but only those pairs closer than this (the loaded flanks)
 
 
 def held_back(rows: Rows, hold: float) -> Rows:
@@ -48,13 +46,17 @@ def linearisation_error(old: Rows, new: Rows, u: np.ndarray) -> float:
     return float(np.abs(g_new - g_old)[near].max()) if near.any() else 0.0
 
 
-def near_only(old: Rows, new: Rows, u: np.ndarray) -> Rows:
-    """``new`` for the pairs near contact, ``old`` for the rest: a far pair's row is renewed
-    only once it comes near (each renewed row in the working set costs a back-substitution)."""
-    near = ((old.g0 + old.G @ u) < GEO_NEAR) | ((new.g0 + new.G @ u) < GEO_NEAR)
+def _blend(old: Rows, new: Rows, near: np.ndarray) -> Rows:
+    """``new``'s rows where ``near``, ``old``'s elsewhere (same slave nodes, same pairs)."""
     Dn, Df = sp.diags(near.astype(float)), sp.diags((~near).astype(float))
     return replace(new, G=(Dn @ new.G + Df @ old.G).tocsr(), g0=np.where(near, new.g0, old.g0),
                    slip=(Dn @ new.slip + Df @ old.slip).tocsr())
+
+
+def near_only(old: Rows, new: Rows, u: np.ndarray) -> Rows:
+    """``new`` for the pairs near contact, ``old`` for the rest: a far pair's row is renewed
+    only once it comes near (each renewed row in the working set costs a back-substitution)."""
+    return _blend(old, new, ((old.g0 + old.G @ u) < GEO_NEAR) | ((new.g0 + new.G @ u) < GEO_NEAR))
 
 
 def gap_only(old: Rows, new: Rows, u: np.ndarray) -> Rows:
@@ -133,25 +135,20 @@ def redetect_teeth(model: LostMotionModel, torque: float,
                     level: LevelSolution) -> tuple[LevelSolution, float]:
     """Independent check at +-T: re-detect every FS/CS pair in the zones at the deformed
     configuration (nonlinear gap, no candidate threshold).  Large twists slide the flanks
-    along each other; if the linearised pairing then misses more than RELIN_TOL, re-pair
-    and re-linearise the tooth rows about this state and solve the level again.
+    along each other; if the linearised pairing then misses more than ``GEO_TOL``, re-pair
+    and re-linearise the tooth pairs within ``GEO_NEAR`` of contact about this state and solve the level again.
 
     Returns the final level and its re-detected penetration (mm)."""
     geom = model.geometry
     for relin in range(4):
         chk = tooth_rows(model.structure, geom, level.u_watch, np.inf)
         pen_nl = float(-(chk.g0 + chk.G @ level.u_watch).min())
-        if pen_nl <= RELIN_TOL or relin == 3:
+        if pen_nl <= GEO_TOL or relin == 3:
             break
         tr = model.rows["tooth"]
         new = tooth_rows(model.structure, geom, level.u_watch, np.inf, nodes=tr.slave_nodes)
         # only pairs at or near contact are re-linearised; the open flanks
         # keep the WG-state pairing, which is the right one for the way back
-        near = (tr.g0 + tr.G @ level.u_watch) < RELIN_NEAR
-        Dn = sp.diags(near.astype(float))
-        Df = sp.diags((~near).astype(float))
-        mixed = replace(tr, G=(Dn @ new.G + Df @ tr.G).tocsr(), g0=np.where(near, new.g0, tr.g0),
-                        slip=(Dn @ new.slip + Df @ tr.slip).tocsr())
-        model.replace_rows("tooth", mixed)
+        model.replace_rows("tooth", _blend(tr, new, (tr.g0 + tr.G @ level.u_watch) < GEO_NEAR))
         level = model.solve_level(torque, level.active)
     return level, pen_nl
