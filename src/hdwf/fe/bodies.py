@@ -200,10 +200,10 @@ class Body:
         if self.tie is not None:             # half model: solve on the tied (reduced) dofs
             Fr = np.asarray(self.tie.T @ F)
             Ur = np.zeros((self.tie.shape[1], F.shape[1]))
-            Ur[self.free_dofs] = self.factor.solve(np.ascontiguousarray(Fr[self.free_dofs]))
+            Ur[self.free_dofs] = self.factor.solve(np.asfortranarray(Fr[self.free_dofs]))
             return np.asarray(self.tie @ Ur)
         U = np.zeros((self.stiffness.shape[0], F.shape[1]))
-        U[self.free_dofs] = self.factor.solve(np.ascontiguousarray(F[self.free_dofs]))
+        U[self.free_dofs] = self.factor.solve(np.asfortranarray(F[self.free_dofs]))
         return U
 
     def node_displacements(self, nodes: np.ndarray, u_watch: np.ndarray) -> np.ndarray:

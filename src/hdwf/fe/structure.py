@@ -27,6 +27,10 @@ from hdwf.fe.bodies import Body
 
 ModeName = tuple[str, str]      # (body, mode), e.g. ("fs", "rot")
 
+# Columns per back-substitution: SuperLU's multi-column solve is fastest per column when the
+# block stays in cache (FS of HD 42, default half mesh: 2.7 ms a column at 16, 4.4 ms at 256)
+SOLVE_BATCH = 16
+
 
 @dataclass(frozen=True)
 class RigidModes:
@@ -111,7 +115,7 @@ class Structure:
         """Map watch-vector force columns (nwatch x k) to full-body force vectors."""
         b = self.bodies[name]
         wn = b.watch_nodes
-        F = np.zeros((b.stiffness.shape[0], Gt.shape[1]))
+        F = np.zeros((b.stiffness.shape[0], Gt.shape[1]), order="F")   # SuperLU reads columns
         Gd = Gt.toarray()
         F[b.dofs[0, wn]] = Gd[b.watch_index[0, wn]]
         F[b.dofs[1, wn]] = Gd[b.watch_index[1, wn]]
@@ -128,8 +132,8 @@ class Structure:
             cols = np.flatnonzero(np.diff(Gt[sl].tocsc().indptr))
             if cols.size == 0:
                 continue
-            for c0 in range(0, cols.size, 256):   # bounded memory per batch
-                cc = cols[c0:c0 + 256]
+            for c0 in range(0, cols.size, SOLVE_BATCH):
+                cc = cols[c0:c0 + SOLVE_BATCH]
                 Fw = Gt[:, cc].tocsc()
                 F = self.watch_to_body(name, Fw)
                 U = b.solve(F)
