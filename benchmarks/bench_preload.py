@@ -37,6 +37,7 @@ from hdwf.fe import solve_lost_motion
 ROOT = Path(__file__).resolve().parents[1]
 TABLES = {"hd42": "table4_hd42_fea.csv", "hd120": "table5_hd120_fea.csv"}
 COLUMNS = ["d_mm", "D_mm", "Gr_mm", "rFS_mm", "rCS_mm"]
+EXIT_ARC_DEG = 45.0   # a tooth loaded farther than this from a major axis is an exit-zone tip crossing
 
 
 def _sets(text: str) -> list[int]:
@@ -72,11 +73,12 @@ def solve_all(unit: str, sets: list[int], interferences: list[float], zone90: bo
                    "reason": r.reason[:200], "phi": r.lost_motion_arcmin,
                    "phi_paper": row["lost_motion_arcmin"], "solve_s": r.solve_s, "mesh_s": mesh_s,
                    "teeth": r.teeth_in_contact, "pen_redetected_um": r.max_penetration_redetected_um,
-                   "notes": r.notes}
+                   "notes": r.notes, "loaded_arc_deg": r.loaded_arc_deg}
             pd.DataFrame([rec]).to_csv(out, mode="a", header=not out.exists(), index=False)
             print(f"{unit} set {s:2d} δ={im:.2f} m zone {rec['zone_deg']:.0f}: {r.status} "
                   f"Φ {r.lost_motion_arcmin:.4f} (paper {row['lost_motion_arcmin']:.4f}) "
-                  f"solve {r.solve_s:.1f} s teeth {r.teeth_in_contact} {r.reason[:120]}", flush=True)
+                  f"solve {r.solve_s:.1f} s teeth {r.teeth_in_contact} out to {r.loaded_arc_deg:.1f}° "
+                  f"{r.reason[:120]}", flush=True)
 
 
 def _slope(table: pd.DataFrame, sets, phi: np.ndarray) -> float:
@@ -114,7 +116,9 @@ def summary(out: Path):
                   f"Φ {ok.phi.min():.3f}–{ok.phi.max():.3f}, median ratio ours/paper {a['ratio']:.3f}, "
                   f"Spearman {a['rho']:.3f}, R² {a['r2']:.3f}, "
                   f"dΦ/dr_FS {a['slope']:.4f} ({a['paper_slope']:.4f}) arcmin/µm, "
-                  f"solve median {ok.solve_s.median():.1f} s (max {ok.solve_s.max():.1f})")
+                  f"solve median {ok.solve_s.median():.1f} s (max {ok.solve_s.max():.1f})"
+                  + (f", loaded beyond {EXIT_ARC_DEG:g}° on {int((ok.loaded_arc_deg > EXIT_ARC_DEG).sum())}"
+                     if "loaded_arc_deg" in ok else ""))
 
 
 if __name__ == "__main__":

@@ -12,13 +12,13 @@ import pytest
 
 from hdwf.drive.geometry import cs_half_space_angle, drive_geometry, fs_half_angle
 from hdwf.drive.mesh import build_mesh
-from hdwf.drive.relief import relief_start_depth, tip_relief
-from hdwf.fe import LostMotionModel
+from hdwf.drive.relief import PRELOAD_TIP_RELIEF, relief_start_depth, tip_relief
+from hdwf.fe import LostMotionModel, solve_lost_motion
 from hdwf.fe.cycle import mount_wave_generator
 
 COARSE = {"elements_over_height": 5, "elements_over_thickness": 3, "symmetry": "half"}
 NOMINAL = {"hd42": (31.0, 42.0, 0.015, 0.0, 0.0), "hd120": (90.0, 120.0, 0.030, 0.0, 0.0)}
-CHOSEN = 1.1     # the multiple of the derived relief the benchmarks use (docs/fe-model.md)
+CHOSEN = PRELOAD_TIP_RELIEF     # the multiple of the derived relief a preload is solved with
 
 
 def _path(g, phi):
@@ -104,3 +104,22 @@ def test_exit_zone_is_clear_at_the_nominal_design(unit):
     assert _exit_overlap_um(unit, 0.0) > 20.0
     assert _exit_overlap_um(unit, 1.0) < 0.35 * _exit_overlap_um(unit, 0.0)
     assert _exit_overlap_um(unit, CHOSEN) <= 0.0
+
+
+@pytest.mark.slow
+def test_loaded_arc_shows_where_the_torque_is_carried():
+    """``loaded_arc_deg``: the loaded tooth at +T farthest from a major axis.  With the offsets
+    past the preload allowance only the working mesh next to the major axis carries the torque
+    (a few teeth within 20°); HD 42's loosest bearing of Table 3 (d, D, G_r at their clearance
+    bounds) with zero offsets and a heavy allowance pushes the FS so far back that teeth all
+    round, out to the minor axis, are loaded: the exit-zone tip crossings the diagnostic is
+    there to show (docs/fe-model.md, "The studies' model")."""
+    g_open = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.02, 0.02, interference_m=0.17,
+                            tip_relief=PRELOAD_TIP_RELIEF)
+    r_open = solve_lost_motion(g_open, build_mesh(g_open, **COARSE), steps_per_ramp=1)
+    g_tight = drive_geometry("hd42", 31.016, 41.984, 0.020, 0.0, 0.0, interference_m=0.17,
+                             tip_relief=PRELOAD_TIP_RELIEF)
+    r_tight = solve_lost_motion(g_tight, build_mesh(g_tight, **COARSE), steps_per_ramp=1)
+    assert r_open.status == r_tight.status == "ok"
+    assert r_open.loaded_arc_deg < 20.0 and r_open.teeth_in_contact <= 12
+    assert r_tight.loaded_arc_deg > 60.0 and r_tight.teeth_in_contact > 100

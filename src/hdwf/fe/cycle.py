@@ -63,6 +63,7 @@ class LostMotionResult:
     wg_deflection_um: float = float("nan")   # FS bore radial displacement at major axis
     max_penetration_redetected_um: float = float("nan")  # tooth pairs re-found at +-T
     overlap_outside_zones_um: float = float("nan")  # teeth outside the zones, at the mount
+    loaded_arc_deg: float = float("nan")   # largest angle from a major axis of a tooth loaded at +T
     notes: str = ""
     fields: dict | None = None   # with keep_fields: {"wg": {...}, "plus": {...}} body -> (2, n) mm
 
@@ -88,6 +89,7 @@ class _TorqueTest:
     max_penetration: float             # mm, over every level (balls excluded)
     max_penetration_redetected: float  # mm, tooth pairs re-found at +-T
     teeth_in_contact: int              # at +T
+    loaded_arc_deg: float              # at +T: the loaded tooth farthest from a major axis
     fields: dict | None                # displacement fields (keep_fields)
 
 
@@ -224,15 +226,20 @@ def mount_wave_generator(model: LostMotionModel,
                                  overlap_outside_zones(model, state) * 1000.0)
 
 
-def _teeth_in_contact(model: LostMotionModel, level: LevelSolution, kinds: np.ndarray) -> int:
-    """FS teeth with a loaded pair (both halves counted in the half model)."""
+def _teeth_in_contact(model: LostMotionModel, level: LevelSolution, kinds: np.ndarray) -> tuple[int, float]:
+    """FS teeth with a loaded pair (both halves counted in the half model), and the largest
+    angle (deg) of one of them from the nearer major axis: a loaded tooth far out in the exit
+    zone (beyond about 45 deg) is a tip crossing, not the working mesh."""
     tr = model.rows["tooth"]
     ti = [i for (kk, i) in level.pair_ids if kk == "tooth"]
     pt = level.normal_force[kinds == "tooth"]
-    count = int(np.unique(tr.tooth[np.array(ti)[pt > 0]]).size)
+    teeth = np.unique(tr.tooth[np.array(ti, dtype=np.int64)[pt > 0]])
+    count = int(teeth.size)
     if model.half:
         count *= 2             # every tooth has its image at +pi
-    return count
+    angle = np.mod(teeth * 360.0 / model.geometry.z_fs, 180.0)
+    arc = float(np.minimum(angle, 180.0 - angle).max()) if teeth.size else float("nan")
+    return count, arc
 
 
 def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWaveGenerator,
@@ -245,7 +252,7 @@ def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWave
         model.rows["tooth"] = tooth_rows(model.structure, geom, mounted.solution.u_watch, cand)
     model.mode_list = model.mode_list + [("fs", "rot")]
     active = mounted.solution.active
-    twists, maxpen, maxpen_nl, tooth_count = [], 0.0, 0.0, 0
+    twists, maxpen, maxpen_nl, tooth_count, arc = [], 0.0, 0.0, 0, float("nan")
     last_sign = 1.0
     for fraction in frac:
         if abs(fraction) > 1e-12:
@@ -275,8 +282,8 @@ def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWave
         if abs(fraction - 1.0) < 1e-12:
             if fields is not None and "plus" not in fields:
                 fields["plus"] = at.full_displacements(level, T)
-            tooth_count = _teeth_in_contact(at, level, kinds)
-    return _TorqueTest(np.array(twists), maxpen, maxpen_nl, tooth_count, fields)
+            tooth_count, arc = _teeth_in_contact(at, level, kinds)
+    return _TorqueTest(np.array(twists), maxpen, maxpen_nl, tooth_count, arc, fields)
 
 
 def _result(model: LostMotionModel, changes: ModelChanges, frac: np.ndarray,
@@ -296,7 +303,7 @@ def _result(model: LostMotionModel, changes: ModelChanges, frac: np.ndarray,
         status="ok", reason="", solve_s=time.perf_counter() - t0,
         factorize_s=model.factorize_s, n_dofs=model.n_dofs, wg_deflection_um=mounted.deflection_um,
         max_penetration_redetected_um=max(0.0, maxpen_nl) * 1000.0,
-        overlap_outside_zones_um=mounted.outside_overlap_um,
+        overlap_outside_zones_um=mounted.outside_overlap_um, loaded_arc_deg=test.loaded_arc_deg,
         notes=(f"zero-torque steps at {ZERO_TORQUE_BIAS:g} T_test towards the last load; "
                f"tooth penetration re-detected at the deformed state at +-T: "
                f"{max(0.0, maxpen_nl) * 1000:.4f} um; teeth outside the solved zones overlap by "
