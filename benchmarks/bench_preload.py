@@ -112,13 +112,13 @@ def summary(out: Path):
         for (im, zone), d in du.groupby(["interference_m", "zone_deg"]):
             ok = d[d.status == "ok"]
             a = agreement(table, ok)
-            print(f"{unit} mesh {size} relief {rel:g} δ={im:.2f} m zone {zone:.0f}: {len(ok)}/{len(d)} ok, "
+            print(f"{unit} mesh {size} relief {rel:g} δ={im:.3f} m zone {zone:.0f}: {len(ok)}/{len(d)} ok, "
                   f"Φ {ok.phi.min():.3f}–{ok.phi.max():.3f}, median ratio ours/paper {a['ratio']:.3f}, "
                   f"Spearman {a['rho']:.3f}, R² {a['r2']:.3f}, "
                   f"dΦ/dr_FS {a['slope']:.4f} ({a['paper_slope']:.4f}) arcmin/µm, "
                   f"solve median {ok.solve_s.median():.1f} s (max {ok.solve_s.max():.1f})"
                   + (f", loaded beyond {EXIT_ARC_DEG:g}° on {int((ok.loaded_arc_deg > EXIT_ARC_DEG).sum())}"
-                     if "loaded_arc_deg" in ok else ""))
+                     if "loaded_arc_deg" in ok and ok.loaded_arc_deg.notna().any() else ""))
 
 
 if __name__ == "__main__":
