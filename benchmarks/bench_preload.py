@@ -33,11 +33,11 @@ from scipy.stats import spearmanr
 from hdwf.drive.geometry import drive_geometry
 from hdwf.drive.mesh import build_mesh
 from hdwf.fe import solve_lost_motion
+from hdwf.fe.cycle import EXIT_ARC_DEG
 
 ROOT = Path(__file__).resolve().parents[1]
 TABLES = {"hd42": "table4_hd42_fea.csv", "hd120": "table5_hd120_fea.csv"}
 COLUMNS = ["d_mm", "D_mm", "Gr_mm", "rFS_mm", "rCS_mm"]
-EXIT_ARC_DEG = 45.0   # a tooth loaded farther than this from a major axis is an exit-zone tip crossing
 
 
 def _sets(text: str) -> list[int]:

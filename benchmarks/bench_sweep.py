@@ -1,6 +1,6 @@
 """Lost motion of one design against one design variable: Phi, the FS push and where the torque goes.
 
-Solves a base design (HD 42 or HD 120, nominal bearing unless given) at every value of one of
+Solves a base design (HD 42 or HD 120, Table 3's nominal design unless given) at every value of one of
 d_mm, D_mm, Gr_mm, rFS_mm, rCS_mm, bare or with the preloaded engagement (``--preload DELTA``,
 ``--tip-relief`` its multiple of the derived relief, default the studies' ``PRELOAD_TIP_RELIEF``),
 and prints per value: Phi (and phi, phi'), the FS bore's radial push at the major axis after the
@@ -21,30 +21,35 @@ import _one_thread  # noqa: F401,E402  (first: one BLAS thread, hdwf importable)
 
 import pandas as pd
 
-from hdwf.drive.geometry import drive_geometry
+from hdwf import PARAMETER_COLUMNS
+from hdwf.drive.design import geometry_of
 from hdwf.drive.mesh import build_mesh
 from hdwf.drive.relief import PRELOAD_TIP_RELIEF
 from hdwf.fe import solve_lost_motion
+from hdwf.study.paper import load_bounds
 
-COLUMNS = ("d_mm", "D_mm", "Gr_mm", "rFS_mm", "rCS_mm")
-NOMINAL = {"hd42": (31.0, 42.0, 0.015, 0.0, 0.0), "hd120": (90.0, 120.0, 0.030, 0.025, 0.025)}
+ROOT = Path(__file__).resolve().parents[1]
 
 
-def _assignments(text: str) -> dict[str, str]:
-    pairs = dict(part.split("=", 1) for part in text.split(",") if part) if text else {}
-    unknown = set(pairs) - set(COLUMNS)
+def _check_names(names) -> None:
+    unknown = set(names) - set(PARAMETER_COLUMNS)
     if unknown:
-        raise SystemExit(f"unknown design variable(s) {sorted(unknown)}; expected {COLUMNS}")
-    return pairs
+        raise SystemExit(f"unknown design variable(s) {sorted(unknown)}; expected {PARAMETER_COLUMNS}")
+
+
+def _assignments(text: str) -> dict[str, float]:
+    pairs = dict(part.split("=", 1) for part in text.split(",") if part)
+    _check_names(pairs)
+    return {k: float(v) for k, v in pairs.items()}
 
 
 def sweep(unit: str, base: dict[str, float], name: str, values: list[float], preload: float,
           relief: float, mesh_size: tuple[int, int], steps_per_ramp: int) -> pd.DataFrame:
+    nominal = load_bounds(ROOT / "data" / "paper", unit).loc["nominal"].to_dict()
     rows = []
     for value in values:
-        params = {**dict(zip(COLUMNS, NOMINAL[unit])), **base, name: value}
-        g = drive_geometry(unit, *(params[c] for c in COLUMNS), interference_m=preload,
-                           tip_relief=relief if preload > 0 else 0.0)
+        params = {**nominal, **base, name: value}
+        g = geometry_of(unit, params, interference_m=preload, tip_relief=relief if preload > 0 else 0.0)
         mesh = build_mesh(g, elements_over_height=mesh_size[0], elements_over_thickness=mesh_size[1],
                           symmetry="half")
         r = solve_lost_motion(g, mesh, steps_per_ramp=steps_per_ramp)
@@ -61,7 +66,7 @@ def sweep(unit: str, base: dict[str, float], name: str, values: list[float], pre
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--unit", choices=tuple(NOMINAL), default="hd42")
+    ap.add_argument("--unit", choices=("hd42", "hd120"), default="hd42")
     ap.add_argument("--base", default="", help="design variables off nominal, e.g. rFS_mm=0.016,rCS_mm=0.016")
     ap.add_argument("--vary", required=True, help="NAME=v1,v2,... e.g. d_mm=31.0,31.008,31.016")
     ap.add_argument("--preload", type=float, default=0.0, help="interference_m (0: bare section)")
@@ -71,9 +76,8 @@ if __name__ == "__main__":
     ap.add_argument("--out", type=Path, default=None)
     a = ap.parse_args()
     name, _, vals = a.vary.partition("=")
-    _assignments(f"{name}=0")
-    base = {k: float(v) for k, v in _assignments(a.base).items()}
-    df = sweep(a.unit, base, name, [float(v) for v in vals.split(",")], a.preload, a.tip_relief,
+    _check_names([name])
+    df = sweep(a.unit, _assignments(a.base), name, [float(v) for v in vals.split(",")], a.preload, a.tip_relief,
                tuple(int(n) for n in a.mesh.split("x")), a.steps_per_ramp)
     if a.out is not None:
         df.to_csv(a.out, mode="a", header=not a.out.exists(), index=False)

@@ -41,6 +41,7 @@ from hdwf.fe.relinearise import redetect_teeth, settle_teeth
 from hdwf.fe.solver import TOL_GAP, LevelSolution
 
 ZERO_TORQUE_BIAS = 1e-3  # fraction of the test torque used at the zero-torque steps
+EXIT_ARC_DEG = 45.0      # a tooth loaded farther from a major axis is a tip crossing, not the working mesh
 
 
 @dataclass
@@ -229,7 +230,7 @@ def mount_wave_generator(model: LostMotionModel,
 def _teeth_in_contact(model: LostMotionModel, level: LevelSolution, kinds: np.ndarray) -> tuple[int, float]:
     """FS teeth with a loaded pair (both halves counted in the half model), and the largest
     angle (deg) of one of them from the nearer major axis: a loaded tooth far out in the exit
-    zone (beyond about 45 deg) is a tip crossing, not the working mesh."""
+    zone (beyond ``EXIT_ARC_DEG``) is a tip crossing, not the working mesh."""
     tr = model.rows["tooth"]
     ti = [i for (kk, i) in level.pair_ids if kk == "tooth"]
     pt = level.normal_force[kinds == "tooth"]

@@ -115,7 +115,7 @@ class Structure:
         """Map watch-vector force columns (nwatch x k) to full-body force vectors."""
         b = self.bodies[name]
         wn = b.watch_nodes
-        F = np.zeros((b.stiffness.shape[0], Gt.shape[1]), order="F")   # SuperLU reads columns
+        F = np.zeros((b.stiffness.shape[0], Gt.shape[1]))
         Gd = Gt.toarray()
         F[b.dofs[0, wn]] = Gd[b.watch_index[0, wn]]
         F[b.dofs[1, wn]] = Gd[b.watch_index[1, wn]]

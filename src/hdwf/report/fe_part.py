@@ -13,6 +13,7 @@ from scipy import stats as st
 
 from hdwf import PARAMETERS
 from hdwf.common.io import read_json
+from hdwf.fe.cycle import EXIT_ARC_DEG
 from hdwf.report.artefacts import FeSettings, ReportInputs, StudyArtefacts
 from hdwf.report.document import UNIT_NAMES, Document, fmt, lit, math_label
 from hdwf.report.figures import agreement_figure, curves_figure, knee_figure
@@ -123,8 +124,6 @@ def _solve_summary(name: str, lm: pd.DataFrame) -> str:
               f"{int(lm['teeth_in_contact'].max())}; largest penetration {fmt(lm['max_penetration_um'].max(), 4)} µm. "
             + _unsolved_overlap(lm) + _exit_zone_load(lm) + timing)
 
-
-EXIT_ARC_DEG = 45.0   # farther from a major axis a loaded tooth is a tip crossing, not the working mesh
 
 
 def _exit_zone_load(lm: pd.DataFrame) -> str:
