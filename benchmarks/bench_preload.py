@@ -16,6 +16,8 @@ Run with one thread, e.g.
 with every tooth watched at every interference.  The summary adds Phi's range, R² (squared
 Pearson correlation ours vs paper) and the paper's dPhi/dr_FS on the same designs.
 ``--summary-only`` re-reads ``--out`` and prints the summary.
+``--deflection 1.4 --addendum-frac 0.38 --interference 0`` solves the other preload, a deeper
+cam (``DriveGeometry.deflection_coeff``; docs/fe-model.md, "A deeper cam instead").
 """
 
 from __future__ import annotations
@@ -49,11 +51,13 @@ def _sets(text: str) -> list[int]:
 
 
 def solve_all(unit: str, sets: list[int], interferences: list[float], zone90: bool, out: Path,
-              tip_relief: float = 0.0, zone: float | None = None, mesh_size: tuple[int, int] = (5, 3)):
+              tip_relief: float = 0.0, zone: float | None = None, mesh_size: tuple[int, int] = (5, 3),
+              cam: dict | None = None):
+    cam = cam or {}     # deflection_coeff / addendum_frac for drive_geometry
     table = pd.read_csv(ROOT / "data" / "paper" / TABLES[unit]).set_index("set")
     for s in sets:
         row = table.loc[s]
-        g0 = drive_geometry(unit, *(row[c] for c in COLUMNS), tip_relief=tip_relief)
+        g0 = drive_geometry(unit, *(row[c] for c in COLUMNS), tip_relief=tip_relief, **cam)
         t0 = time.perf_counter()
         eh, et = mesh_size
         mesh = build_mesh(g0, elements_over_height=eh, elements_over_thickness=et, symmetry="half")
@@ -62,20 +66,21 @@ def solve_all(unit: str, sets: list[int], interferences: list[float], zone90: bo
         for im, zone_deg in runs:
             # interference is a flank offset of the FS teeth: a new outline, a new mesh
             g = drive_geometry(unit, *(row[c] for c in COLUMNS), interference_m=im,
-                               tip_relief=tip_relief)
+                               tip_relief=tip_relief, **cam)
             m = mesh if im == 0 else build_mesh(g, elements_over_height=eh, elements_over_thickness=et,
                                                 symmetry="half")
             r = solve_lost_motion(g, m, steps_per_ramp=5, zone_deg=zone_deg)
             rec = {"unit": unit, "set": s, "interference_m": im, "tip_relief": tip_relief,
-                   "mesh": f"{eh}x{et}",
-                   "zone_deg": zone_deg if zone_deg else (90.0 if im > 0 else 35.0),
+                   "deflection_coeff": g.deflection_coeff, "addendum_frac": g.addendum / (
+                       g.r_fs_tip - g.r_fs_root), "mesh": f"{eh}x{et}",
+                   "zone_deg": zone_deg if zone_deg else (90.0 if g.preloaded else 35.0),
                    "status": r.status, "overlap_outside_zones_um": r.overlap_outside_zones_um,
                    "reason": r.reason[:200], "phi": r.lost_motion_arcmin,
                    "phi_paper": row["lost_motion_arcmin"], "solve_s": r.solve_s, "mesh_s": mesh_s,
                    "teeth": r.teeth_in_contact, "pen_redetected_um": r.max_penetration_redetected_um,
                    "notes": r.notes, "loaded_arc_deg": r.loaded_arc_deg}
             pd.DataFrame([rec]).to_csv(out, mode="a", header=not out.exists(), index=False)
-            print(f"{unit} set {s:2d} δ={im:.2f} m zone {rec['zone_deg']:.0f}: {r.status} "
+            print(f"{unit} set {s:2d} κ={g.deflection_coeff:g} δ={im:.2f} m zone {rec['zone_deg']:.0f}: {r.status} "
                   f"Φ {r.lost_motion_arcmin:.4f} (paper {row['lost_motion_arcmin']:.4f}) "
                   f"solve {r.solve_s:.1f} s teeth {r.teeth_in_contact} out to {r.loaded_arc_deg:.1f}° "
                   f"{r.reason[:120]}", flush=True)
@@ -107,12 +112,15 @@ def summary(out: Path):
         df["tip_relief"] = 0.0
     if "mesh" not in df:
         df["mesh"] = "5x3"
-    for (unit, rel, size), du in df.groupby(["unit", "tip_relief", "mesh"]):
+    if "deflection_coeff" not in df:
+        df["deflection_coeff"], df["addendum_frac"] = 1.0, 0.45
+    for (unit, rel, size, kappa, ha), du in df.groupby(["unit", "tip_relief", "mesh", "deflection_coeff",
+                                                       "addendum_frac"]):
         table = pd.read_csv(ROOT / "data" / "paper" / TABLES[unit]).set_index("set")
         for (im, zone), d in du.groupby(["interference_m", "zone_deg"]):
             ok = d[d.status == "ok"]
             a = agreement(table, ok)
-            print(f"{unit} mesh {size} relief {rel:g} δ={im:.3f} m zone {zone:.0f}: {len(ok)}/{len(d)} ok, "
+            print(f"{unit} mesh {size} relief {rel:g} κ={kappa:g} addendum {ha:.3g} h δ={im:.3f} m zone {zone:.0f}: {len(ok)}/{len(d)} ok, "
                   f"Φ {ok.phi.min():.3f}–{ok.phi.max():.3f}, median ratio ours/paper {a['ratio']:.3f}, "
                   f"Spearman {a['rho']:.3f}, R² {a['r2']:.3f}, "
                   f"dΦ/dr_FS {a['slope']:.4f} ({a['paper_slope']:.4f}) arcmin/µm, "
@@ -134,9 +142,14 @@ if __name__ == "__main__":
                     help="zone half width (deg) for every run (default: by interference)")
     ap.add_argument("--mesh", default="5x3",
                     help="elements over the tooth height x thickness (10x6 is the studies' default)")
+    ap.add_argument("--deflection", type=float, default=1.0,
+                    help="DriveGeometry.deflection_coeff: the cam pushes this many w0 (> 1: a deeper cam)")
+    ap.add_argument("--addendum-frac", type=float, default=None,
+                    help="addendum / tooth height of FS and CS (default the unit's 0.45)")
     ap.add_argument("--summary-only", action="store_true")
     a = ap.parse_args()
     if not a.summary_only:
         solve_all(a.unit, _sets(a.sets), [float(x) for x in a.interference.split(",")], a.zone90,
-                  a.out, a.tip_relief, a.zone, tuple(int(n) for n in a.mesh.split("x")))
+                  a.out, a.tip_relief, a.zone, tuple(int(n) for n in a.mesh.split("x")),
+                  {"deflection_coeff": a.deflection, "addendum_frac": a.addendum_frac})
     summary(a.out)

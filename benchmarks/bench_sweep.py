@@ -6,6 +6,8 @@ d_mm, D_mm, Gr_mm, rFS_mm, rCS_mm, bare or with the preloaded engagement (``--pr
 and prints per value: Phi (and phi, phi'), the FS bore's radial push at the major axis after the
 mount, the teeth in contact at +T and ``loaded_arc_deg`` (the loaded tooth farthest from a major
 axis: beyond about 45 deg a tip crossing in the exit zone). ``--out`` appends the rows to a CSV.
+``--deflection KAPPA --addendum-frac A`` solves the other preload, a deeper cam
+(``DriveGeometry.deflection_coeff``), instead of or with the flank allowance.
 
 Example (docs/fe-model.md, "Where the torque is carried"):
   OMP_NUM_THREADS=1 python benchmarks/bench_sweep.py --unit hd42 --base rFS_mm=0.016,rCS_mm=0.016 \\
@@ -44,20 +46,23 @@ def _assignments(text: str) -> dict[str, float]:
 
 
 def sweep(unit: str, base: dict[str, float], name: str, values: list[float], preload: float,
-          relief: float, mesh_size: tuple[int, int], steps_per_ramp: int) -> pd.DataFrame:
+          relief: float, mesh_size: tuple[int, int], steps_per_ramp: int,
+          shape: dict | None = None) -> pd.DataFrame:
     nominal = load_bounds(ROOT / "data" / "paper", unit).loc["nominal"].to_dict()
     rows = []
     for value in values:
         params = {**nominal, **base, name: value}
-        g = geometry_of(unit, params, interference_m=preload, tip_relief=relief if preload > 0 else 0.0)
+        g = geometry_of(unit, params, interference_m=preload, tip_relief=relief if preload > 0 else 0.0,
+                        **(shape or {}))
         mesh = build_mesh(g, elements_over_height=mesh_size[0], elements_over_thickness=mesh_size[1],
                           symmetry="half")
         r = solve_lost_motion(g, mesh, steps_per_ramp=steps_per_ramp)
         rows.append({"unit": unit, **params, "interference_m": preload, "tip_relief": g.tip_relief,
+                     "deflection_coeff": g.deflection_coeff,
                      "status": r.status, "phi": r.lost_motion_arcmin, "phi_plus": r.phi_plus_arcmin,
                      "phi_minus": r.phi_minus_arcmin, "push_um": r.wg_deflection_um,
                      "teeth": r.teeth_in_contact, "loaded_arc_deg": r.loaded_arc_deg, "solve_s": r.solve_s})
-        print(f"{unit} {name}={value:g} δ={preload:g} m relief {g.tip_relief:g}: {r.status} "
+        print(f"{unit} {name}={value:g} κ={g.deflection_coeff:g} δ={preload:g} m relief {g.tip_relief:g}: {r.status} "
               f"Φ {r.lost_motion_arcmin:.4f} arcmin (+{r.phi_plus_arcmin:.4f} / −{r.phi_minus_arcmin:.4f}), "
               f"push {r.wg_deflection_um:.1f} µm, teeth {r.teeth_in_contact} out to {r.loaded_arc_deg:.1f}°, "
               f"{r.solve_s:.1f} s {r.reason[:100]}", flush=True)
@@ -73,11 +78,16 @@ if __name__ == "__main__":
     ap.add_argument("--tip-relief", type=float, default=PRELOAD_TIP_RELIEF)
     ap.add_argument("--mesh", default="10x6", help="elements over the tooth height x thickness")
     ap.add_argument("--steps-per-ramp", type=int, default=1)
+    ap.add_argument("--deflection", type=float, default=1.0,
+                    help="DriveGeometry.deflection_coeff: the cam pushes this many w0 (> 1: a deeper cam)")
+    ap.add_argument("--addendum-frac", type=float, default=None,
+                    help="addendum / tooth height of FS and CS (default the unit's 0.45)")
     ap.add_argument("--out", type=Path, default=None)
     a = ap.parse_args()
     name, _, vals = a.vary.partition("=")
     _check_names([name])
     df = sweep(a.unit, _assignments(a.base), name, [float(v) for v in vals.split(",")], a.preload, a.tip_relief,
-               tuple(int(n) for n in a.mesh.split("x")), a.steps_per_ramp)
+               tuple(int(n) for n in a.mesh.split("x")), a.steps_per_ramp,
+               {"deflection_coeff": a.deflection, "addendum_frac": a.addendum_frac})
     if a.out is not None:
         df.to_csv(a.out, mode="a", header=not a.out.exists(), index=False)

@@ -26,6 +26,11 @@ Contents
 * preloaded engagement (``interference_m``, units of m, default 0): the FS flanks are
   thickened by a normal offset interference_m * m, so the wave generator presses the
   teeth into the CS spaces (a preloaded wedge) and r_FS + r_CS first relieve that preload.
+* the other preload, a deeper cam (``deflection_coeff`` kappa = w0/m, default 1): the nominal
+  bearing pushes the FS out by kappa * w0, so the major-axis teeth sit (kappa - 1) m deeper in
+  their CS spaces than the flanks allow (an overlap of (kappa - 1) m sin(alpha) per flank) and
+  only the teeth near the major axis are pressed in.  The tips then need more room than the
+  0.1 h tip/root clearance of the default addenda: ``addendum_frac`` shortens both.
 * ``geometric_backlash_rad/arcmin``: the rigid-body backlash the offsets create.
 
 Levels versus the paper (read before comparing numbers): a normal flank offset r opens a
@@ -210,12 +215,20 @@ class DriveGeometry:
     interference_m: float = 0.0
     # tip relief, in units of the relief the FS tooth's path needs (``hdwf.drive.relief``)
     tip_relief: float = 0.0
+    # deflection coefficient: the nominal bearing pushes the FS out by this many w0 (> 1: the
+    # major-axis teeth are pressed radially into the CS spaces)
+    deflection_coeff: float = 1.0
 
     # ---- derived quantities -------------------------------------------------------
     @property
     def w0(self) -> float:
         """Design radial deflection of the FS at the major axis (2-tooth difference)."""
         return self.module * (self.z_cs - self.z_fs) / 2.0
+
+    @property
+    def preloaded(self) -> bool:
+        """Whether the wave generator presses the teeth in (a flank allowance or a deeper cam)."""
+        return self.interference_m > 0 or self.deflection_coeff > 1
 
     @property
     def interference(self) -> float:
@@ -390,7 +403,8 @@ def geometric_backlash_arcmin(g: DriveGeometry, radial_shortfall_mm: float = 0.0
 # --------------------------------------------------------------------------------------
 def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: float,
                    rCS_mm: float, interference_m: float = 0.0,
-                   tip_relief: float = 0.0) -> DriveGeometry:
+                   tip_relief: float = 0.0, deflection_coeff: float = 1.0,
+                   addendum_frac: float | None = None) -> DriveGeometry:
     """Geometry of one design of unit "hd42" or "hd120" (all lengths in mm).
 
     ``interference_m`` (>= 0, units of the module m): preloaded engagement.  The FS teeth
@@ -404,12 +418,26 @@ def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: fl
     tooth's path needs to leave the mesh without crossing the CS tips
     (``hdwf.drive.relief``); 0 (the default) keeps the plain involutes, whose tips cross
     51-69 deg from the major axis.
+
+    ``deflection_coeff`` (kappa in [1, 2)): the cam is sized so that the nominal bearing pushes
+    the FS out by kappa * w0 at the major axis; 1 (the default) is the 2-tooth difference with
+    the teeth just touching, > 1 presses the teeth near the major axis into their spaces.
+
+    ``addendum_frac`` (in [0.2, 0.5], default the unit's 0.45): addendum of FS and CS teeth as
+    a fraction of the tooth height h; the tip/root clearance at the major axis is (1 - 2 *
+    addendum_frac) h, which a deeper cam eats by (kappa - 1) m.
     """
     if not (interference_m >= 0.0 and math.isfinite(interference_m)):
         raise ValueError(f"interference_m must be finite and >= 0, got {interference_m!r}")
     if not (tip_relief >= 0.0 and math.isfinite(tip_relief)):
         raise ValueError(f"tip_relief must be finite and >= 0, got {tip_relief!r}")
+    if not (1.0 <= deflection_coeff < 2.0):
+        raise ValueError(f"deflection_coeff must be in [1, 2), got {deflection_coeff!r}")
     t = asdict(unit_data(unit))
+    if addendum_frac is not None:
+        if not (0.2 <= addendum_frac <= 0.5):
+            raise ValueError(f"addendum_frac must be in [0.2, 0.5], got {addendum_frac!r}")
+        t["addendum_frac"] = float(addendum_frac)
     m = t["module"]
     h = t["tooth_height"]
     ha = t["addendum_frac"] * h
@@ -420,7 +448,8 @@ def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: fl
     # Cam: the nominal bearing (bore d_nom wrapped on the cam, radial clearance Gr_nom, OD
     # = FS bore) must push the FS out by w0 at the major axis, rigid-body: A + B equals the
     # bore radius + w0 + Gr_nom/2 (the ball gap on the loaded side).
-    A, B = size_cam(t["d_nom"], t["d_nom"] / 2 + w0 + t["Gr_nom"] / 2, t["cam_n"])
+    A, B = size_cam(t["d_nom"], t["d_nom"] / 2 + deflection_coeff * w0 + t["Gr_nom"] / 2,
+                    t["cam_n"])
     return DriveGeometry(
         unit=unit.lower(), d=float(d_mm), D=float(D_mm), Gr=float(Gr_mm),
         r_fs=float(rFS_mm), r_cs=float(rCS_mm),
@@ -435,7 +464,7 @@ def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: fl
         r_cs_tip=r_cs_pitch - ha, r_cs_pitch=r_cs_pitch, r_cs_root=r_cs_pitch + hf,
         r_cs_outer=r_cs_pitch + hf + t["cs_rim"],
         cam_A=A, cam_B=B, cam_n=t["cam_n"], interference_m=float(interference_m),
-        tip_relief=float(tip_relief),
+        tip_relief=float(tip_relief), deflection_coeff=float(deflection_coeff),
     )
 
 

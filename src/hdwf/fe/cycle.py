@@ -2,7 +2,7 @@
 
 Stage 1 pushes the wave generator into the FS (no teeth, FS rotation pinned); the cam rows
 are re-linearised at the deformed configuration until the geometry update is below 1e-6 mm.
-With a preload (``DriveGeometry.interference_m`` > 0) the teeth are then ramped in at
+With a preload (``DriveGeometry.preloaded``) the teeth are then ramped in at
 zero torque (``preload.mount_preloaded``), every tooth watched.  After stage 1 the teeth
 outside the watched zones are checked for overlap (reported, ``overlap_outside_zones_um``).
 Stage 2 builds the tooth rows at the deflected configuration, frees the FS rotation and
@@ -265,7 +265,7 @@ def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWave
         active = level.active    # the next level's warm start, solved with the rows it will use
         at = model
         at_full_torque = abs(abs(fraction) - 1.0) < 1e-12
-        if at_full_torque and model.geometry.interference_m > 0:
+        if at_full_torque and model.geometry.preloaded:
             # preloaded: rows settled at +-T fit that state only, so they are settled on a
             # fork and the way back starts from the mount's rows (and columns) again
             at = model.fork()
@@ -335,7 +335,7 @@ def _zone(geom: DriveGeometry, zone_deg: float | None) -> float:
     """The engagement zones' half width (deg): ``zone_deg``, else by whether teeth are preloaded."""
     if zone_deg is not None:
         return zone_deg
-    return PRELOAD_ZONE_DEG if geom.interference_m > 0 else ZONE_DEG
+    return PRELOAD_ZONE_DEG if geom.preloaded else ZONE_DEG
 
 
 def _check_geometry(geom: DriveGeometry, changes: ModelChanges) -> None:
@@ -376,8 +376,8 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
         Physical additions to the baseline model (set by ``hdwf.validation.effects``).
     zone_deg : float, optional
         Half width (deg) of the tooth zones about the major axis whose contacts are
-        solved; default 35 without preload, every tooth (90) with ``geom.interference_m``
-        > 0 (a preload engages teeth far beyond 35 deg).
+        solved; default 35 without preload, every tooth (90) with ``geom.preloaded``
+        (a preload engages teeth far beyond 35 deg).
 
     Returns
     -------
@@ -394,7 +394,7 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
                                 changes=changes, zone_deg=_zone(geom, zone_deg))
         # the ramp for a preload, and for any zones wider than today's (teeth beyond 35 deg
         # can overlap at the mount); today's 35 deg zones keep today's path
-        ramp = geom.interference_m > 0 or zone_deg not in (None, ZONE_DEG)
+        ramp = geom.preloaded or zone_deg not in (None, ZONE_DEG)
         mounted = mount_wave_generator(model, ramp)
         fields = {"wg": model.full_displacements(mounted.solution, 0.0)} if keep_fields else None
         test = _torque_test(model, frac, mounted, fields)
@@ -432,7 +432,7 @@ def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_r
     """
     for ch in variants:
         _check_geometry(geom, ch)
-    if geom.interference_m > 0:
+    if geom.preloaded:
         return _preloaded_variants(geom, mesh, steps_per_ramp, variants)
     t0 = time.perf_counter()
     frac = torque_fractions(steps_per_ramp)

@@ -90,7 +90,7 @@ class LostMotionModel:
         nwatch = self.structure.nwatch
         # the cut-back only with a preload: without one the FS crosses its whole backlash (80 um
         # on HD 42 set 8 at the paper's density) in one iterate, and cut back there it stalls
-        overshoot = MAX_OVERSHOOT_M * geom.module if geom.interference_m > 0 else np.inf
+        overshoot = MAX_OVERSHOOT_M * geom.module if geom.preloaded else np.inf
         self.solver = ContactSolver(SolverSettings(max_iter, tol_gap, max_overshoot=overshoot),
                                     ball_compliance_coeff(geom, self.material.E),
                                     WorkingSet(nwatch),

@@ -1,7 +1,8 @@
 """Preloaded tooth engagement: the wave generator mounted with the teeth in (a preload ramp).
 
-With a tooth-thickness allowance (``DriveGeometry.interference_m`` > 0) the wave
-generator presses the FS teeth into the CS spaces: after the wave generator alone is
+With a tooth-thickness allowance (``DriveGeometry.interference_m`` > 0) or a deeper cam
+(``deflection_coeff`` > 1; ``DriveGeometry.preloaded``) the wave generator presses the FS
+teeth into the CS spaces: after the wave generator alone is
 mounted (``cycle``, no teeth) the teeth overlap their CS spaces by up to the allowance
 (tens of micrometres), and pushing them apart moves the FS inwards by several times that
 (a wedge of flank angle alpha gives delta / sin alpha radially).  Tooth rows linearised
