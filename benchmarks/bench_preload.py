@@ -17,7 +17,8 @@ with every tooth watched at every interference.  The summary adds Phi's range, R
 Pearson correlation ours vs paper) and the paper's dPhi/dr_FS on the same designs.
 ``--summary-only`` re-reads ``--out`` and prints the summary.
 ``--deflection 1.4 --addendum-frac 0.38 --interference 0`` solves the other preload, a deeper
-cam (``DriveGeometry.deflection_coeff``; docs/fe-model.md, "A deeper cam instead").
+cam (``DriveGeometry.deflection_coeff``; docs/fe-model.md, "A deeper cam instead");
+``--offsets radial`` reads r_FS, r_CS as rack shifts (``DriveGeometry.offset_direction``).
 """
 
 from __future__ import annotations
@@ -72,7 +73,8 @@ def solve_all(unit: str, sets: list[int], interferences: list[float], zone90: bo
             r = solve_lost_motion(g, m, steps_per_ramp=5, zone_deg=zone_deg)
             rec = {"unit": unit, "set": s, "interference_m": im, "tip_relief": tip_relief,
                    "deflection_coeff": g.deflection_coeff, "addendum_frac": g.addendum / (
-                       g.r_fs_tip - g.r_fs_root), "mesh": f"{eh}x{et}",
+                       g.r_fs_tip - g.r_fs_root), "offset_direction": g.offset_direction,
+                   "mesh": f"{eh}x{et}",
                    "zone_deg": zone_deg if zone_deg else (90.0 if g.preloaded else 35.0),
                    "status": r.status, "overlap_outside_zones_um": r.overlap_outside_zones_um,
                    "reason": r.reason[:200], "phi": r.lost_motion_arcmin,
@@ -114,13 +116,15 @@ def summary(out: Path):
         df["mesh"] = "5x3"
     if "deflection_coeff" not in df:
         df["deflection_coeff"], df["addendum_frac"] = 1.0, 0.45
-    for (unit, rel, size, kappa, ha), du in df.groupby(["unit", "tip_relief", "mesh", "deflection_coeff",
-                                                       "addendum_frac"]):
+    if "offset_direction" not in df:
+        df["offset_direction"] = "normal"
+    for (unit, rel, size, kappa, ha, od), du in df.groupby(["unit", "tip_relief", "mesh", "deflection_coeff",
+                                                           "addendum_frac", "offset_direction"]):
         table = pd.read_csv(ROOT / "data" / "paper" / TABLES[unit]).set_index("set")
         for (im, zone), d in du.groupby(["interference_m", "zone_deg"]):
             ok = d[d.status == "ok"]
             a = agreement(table, ok)
-            print(f"{unit} mesh {size} relief {rel:g} κ={kappa:g} addendum {ha:.3g} h δ={im:.3f} m zone {zone:.0f}: {len(ok)}/{len(d)} ok, "
+            print(f"{unit} mesh {size} {od} offsets relief {rel:g} κ={kappa:g} addendum {ha:.3g} h δ={im:.3f} m zone {zone:.0f}: {len(ok)}/{len(d)} ok, "
                   f"Φ {ok.phi.min():.3f}–{ok.phi.max():.3f}, median ratio ours/paper {a['ratio']:.3f}, "
                   f"Spearman {a['rho']:.3f}, R² {a['r2']:.3f}, "
                   f"dΦ/dr_FS {a['slope']:.4f} ({a['paper_slope']:.4f}) arcmin/µm, "
@@ -146,10 +150,13 @@ if __name__ == "__main__":
                     help="DriveGeometry.deflection_coeff: the cam pushes this many w0 (> 1: a deeper cam)")
     ap.add_argument("--addendum-frac", type=float, default=None,
                     help="addendum / tooth height of FS and CS (default the unit's 0.45)")
+    ap.add_argument("--offsets", choices=("normal", "radial"), default="normal",
+                    help="DriveGeometry.offset_direction: r_FS, r_CS as normal flank offsets or rack shifts")
     ap.add_argument("--summary-only", action="store_true")
     a = ap.parse_args()
     if not a.summary_only:
         solve_all(a.unit, _sets(a.sets), [float(x) for x in a.interference.split(",")], a.zone90,
                   a.out, a.tip_relief, a.zone, tuple(int(n) for n in a.mesh.split("x")),
-                  {"deflection_coeff": a.deflection, "addendum_frac": a.addendum_frac})
+                  {"deflection_coeff": a.deflection, "addendum_frac": a.addendum_frac,
+                   "offset_direction": a.offsets})
     summary(a.out)

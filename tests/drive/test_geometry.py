@@ -133,3 +133,20 @@ def test_every_constant_has_a_source():
 
     assert {f.name for f in dataclasses.fields(UnitData)} == set(_SOURCES)
     assert all(row["source"] for row in assumptions_table())
+
+
+def test_radial_offsets_are_rack_shifts():
+    """offset_direction "radial": r_FS, r_CS shift the cutting rack radially, which moves each
+    involute flank normally by r sin(alpha); the outline is that of normal offsets r sin(alpha),
+    and the rigid backlash 2 (r_FS + r_CS) sin(alpha) / r_b."""
+    radial = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.012, 0.008, offset_direction="radial")
+    k = math.sin(radial.alpha)
+    normal = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.012 * k, 0.008 * k)
+    r = np.linspace(radial.r_fs_root, radial.r_fs_tip, 5)
+    assert np.allclose(fs_half_angle(radial, r), fs_half_angle(normal, r), rtol=0, atol=1e-15)
+    rc = np.linspace(radial.r_cs_tip, radial.r_cs_root, 5)
+    assert np.allclose(cs_half_space_angle(radial, rc), cs_half_space_angle(normal, rc), rtol=0, atol=1e-15)
+    expect = 2 * 0.020 * k / radial.r_cs_base / ARCMIN
+    assert geometric_backlash_arcmin(radial) == pytest.approx(expect, rel=1e-12)
+    with pytest.raises(ValueError, match="offset_direction"):
+        drive_geometry("hd42", 31.0, 42.0, 0.015, 0.0, 0.0, offset_direction="tangential")

@@ -31,6 +31,8 @@ Contents
   their CS spaces than the flanks allow (an overlap of (kappa - 1) m sin(alpha) per flank) and
   only the teeth near the major axis are pressed in.  The tips then need more room than the
   0.1 h tip/root clearance of the default addenda: ``addendum_frac`` shortens both.
+* ``offset_direction`` "radial" reads r_FS, r_CS as rack shifts (each flank moves normally by
+  r sin(alpha)) instead of normal flank offsets (the default).
 * ``geometric_backlash_rad/arcmin``: the rigid-body backlash the offsets create.
 
 Levels versus the paper (read before comparing numbers): a normal flank offset r opens a
@@ -218,6 +220,9 @@ class DriveGeometry:
     # deflection coefficient: the nominal bearing pushes the FS out by this many w0 (> 1: the
     # major-axis teeth are pressed radially into the CS spaces)
     deflection_coeff: float = 1.0
+    # how r_FS, r_CS move a flank: "normal" (a normal offset of r) or "radial" (a rack shift
+    # of r, i.e. a normal offset of r sin(alpha))
+    offset_direction: str = "normal"
 
     # ---- derived quantities -------------------------------------------------------
     @property
@@ -229,6 +234,12 @@ class DriveGeometry:
     def preloaded(self) -> bool:
         """Whether the wave generator presses the teeth in (a flank allowance or a deeper cam)."""
         return self.interference_m > 0 or self.deflection_coeff > 1
+
+    @property
+    def flank_offsets(self) -> tuple[float, float]:
+        """Normal offsets (mm) of the FS and CS flanks that r_FS and r_CS make."""
+        scale = math.sin(self.alpha) if self.offset_direction == "radial" else 1.0
+        return self.r_fs * scale, self.r_cs * scale
 
     @property
     def interference(self) -> float:
@@ -359,7 +370,7 @@ def fs_half_angle(g: DriveGeometry, r):
     rb = g.r_fs_base
     ar = np.arccos(np.clip(rb / r, -1, 1))
     out = ((math.pi * g.module / 2) / (2 * g.r_fs_pitch) + inv(g.alpha) - inv(ar)
-           - (g.r_fs - g.interference) / rb)
+           - (g.flank_offsets[0] - g.interference) / rb)
     return out - g.relief(g.r_fs_tip - r) / r if g.tip_relief else out
 
 
@@ -372,7 +383,7 @@ def cs_half_space_angle(g: DriveGeometry, r):
     r = np.asarray(r, dtype=float)
     rb = g.r_cs_base
     ar = np.arccos(np.clip(rb / r, -1, 1))
-    out = (math.pi * g.module / 2) / (2 * g.r_cs_pitch) + inv(g.alpha) - inv(ar) + g.r_cs / rb
+    out = (math.pi * g.module / 2) / (2 * g.r_cs_pitch) + inv(g.alpha) - inv(ar) + g.flank_offsets[1] / rb
     return out + g.relief(r - g.r_cs_tip) / r if g.tip_relief else out
 
 
@@ -390,7 +401,7 @@ def geometric_backlash_rad(g: DriveGeometry, radial_shortfall_mm: float = 0.0) -
     both ways, so Phi = 2 (r_FS + r_CS + dr sin alpha) / r_b,CS.  A preload interference
     delta enters as -delta (a negative result is a preloaded, rigidly locked pair).
     """
-    gap = g.r_fs + g.r_cs - g.interference + radial_shortfall_mm * math.sin(g.alpha)
+    gap = sum(g.flank_offsets) - g.interference + radial_shortfall_mm * math.sin(g.alpha)
     return 2.0 * gap / g.r_cs_base
 
 
@@ -404,7 +415,8 @@ def geometric_backlash_arcmin(g: DriveGeometry, radial_shortfall_mm: float = 0.0
 def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: float,
                    rCS_mm: float, interference_m: float = 0.0,
                    tip_relief: float = 0.0, deflection_coeff: float = 1.0,
-                   addendum_frac: float | None = None) -> DriveGeometry:
+                   addendum_frac: float | None = None,
+                   offset_direction: str = "normal") -> DriveGeometry:
     """Geometry of one design of unit "hd42" or "hd120" (all lengths in mm).
 
     ``interference_m`` (>= 0, units of the module m): preloaded engagement.  The FS teeth
@@ -423,6 +435,9 @@ def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: fl
     the FS out by kappa * w0 at the major axis; 1 (the default) is the 2-tooth difference with
     the teeth just touching, > 1 presses the teeth near the major axis into their spaces.
 
+    ``offset_direction`` ("normal", the default, or "radial"): r_FS and r_CS as normal offsets
+    of the flanks, or as radial shifts of the cutting rack (a normal offset of r sin(alpha)).
+
     ``addendum_frac`` (in [0.2, 0.5], default the unit's 0.45): addendum of FS and CS teeth as
     a fraction of the tooth height h; the tip/root clearance at the major axis is (1 - 2 *
     addendum_frac) h, which a deeper cam eats by (kappa - 1) m.
@@ -431,6 +446,8 @@ def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: fl
         raise ValueError(f"interference_m must be finite and >= 0, got {interference_m!r}")
     if not (tip_relief >= 0.0 and math.isfinite(tip_relief)):
         raise ValueError(f"tip_relief must be finite and >= 0, got {tip_relief!r}")
+    if offset_direction not in ("normal", "radial"):
+        raise ValueError(f"offset_direction must be 'normal' or 'radial', got {offset_direction!r}")
     if not (1.0 <= deflection_coeff < 2.0):
         raise ValueError(f"deflection_coeff must be in [1, 2), got {deflection_coeff!r}")
     t = asdict(unit_data(unit))
@@ -465,6 +482,7 @@ def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: fl
         r_cs_outer=r_cs_pitch + hf + t["cs_rim"],
         cam_A=A, cam_B=B, cam_n=t["cam_n"], interference_m=float(interference_m),
         tip_relief=float(tip_relief), deflection_coeff=float(deflection_coeff),
+        offset_direction=offset_direction,
     )
 
 

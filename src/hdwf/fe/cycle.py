@@ -249,7 +249,7 @@ def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWave
     geom = model.geometry
     Tn = geom.torque
     if "tooth" not in model.rows:   # (a preloaded mount has its tooth rows already)
-        cand = 0.25 * geom.module + 3 * (geom.r_fs + geom.r_cs)
+        cand = 0.25 * geom.module + 3 * sum(geom.flank_offsets)
         model.rows["tooth"] = tooth_rows(model.structure, geom, mounted.solution.u_watch, cand)
     model.mode_list = model.mode_list + [("fs", "rot")]
     active = mounted.solution.active
