@@ -53,12 +53,12 @@ def _sets(text: str) -> list[int]:
 
 def solve_all(unit: str, sets: list[int], interferences: list[float], zone90: bool, out: Path,
               tip_relief: float = 0.0, zone: float | None = None, mesh_size: tuple[int, int] = (5, 3),
-              cam: dict | None = None):
-    cam = cam or {}     # deflection_coeff / addendum_frac for drive_geometry
+              shape: dict | None = None):
+    shape = shape or {}     # deflection_coeff / addendum_frac / offset_direction for drive_geometry
     table = pd.read_csv(ROOT / "data" / "paper" / TABLES[unit]).set_index("set")
     for s in sets:
         row = table.loc[s]
-        g0 = drive_geometry(unit, *(row[c] for c in COLUMNS), tip_relief=tip_relief, **cam)
+        g0 = drive_geometry(unit, *(row[c] for c in COLUMNS), tip_relief=tip_relief, **shape)
         t0 = time.perf_counter()
         eh, et = mesh_size
         mesh = build_mesh(g0, elements_over_height=eh, elements_over_thickness=et, symmetry="half")
@@ -67,13 +67,13 @@ def solve_all(unit: str, sets: list[int], interferences: list[float], zone90: bo
         for im, zone_deg in runs:
             # interference is a flank offset of the FS teeth: a new outline, a new mesh
             g = drive_geometry(unit, *(row[c] for c in COLUMNS), interference_m=im,
-                               tip_relief=tip_relief, **cam)
+                               tip_relief=tip_relief, **shape)
             m = mesh if im == 0 else build_mesh(g, elements_over_height=eh, elements_over_thickness=et,
                                                 symmetry="half")
             r = solve_lost_motion(g, m, steps_per_ramp=5, zone_deg=zone_deg)
             rec = {"unit": unit, "set": s, "interference_m": im, "tip_relief": tip_relief,
-                   "deflection_coeff": g.deflection_coeff, "addendum_frac": g.addendum / (
-                       g.r_fs_tip - g.r_fs_root), "offset_direction": g.offset_direction,
+                   "deflection_coeff": g.deflection_coeff, "addendum_frac": round(g.addendum / (
+                       g.r_fs_tip - g.r_fs_root), 6), "offset_direction": g.offset_direction,
                    "mesh": f"{eh}x{et}",
                    "zone_deg": zone_deg if zone_deg else (90.0 if g.preloaded else 35.0),
                    "status": r.status, "overlap_outside_zones_um": r.overlap_outside_zones_um,

@@ -7,7 +7,8 @@ and prints per value: Phi (and phi, phi'), the FS bore's radial push at the majo
 mount, the teeth in contact at +T and ``loaded_arc_deg`` (the loaded tooth farthest from a major
 axis: beyond about 45 deg a tip crossing in the exit zone). ``--out`` appends the rows to a CSV.
 ``--deflection KAPPA --addendum-frac A`` solves the other preload, a deeper cam
-(``DriveGeometry.deflection_coeff``), instead of or with the flank allowance.
+(``DriveGeometry.deflection_coeff``), instead of or with the flank allowance; ``--offsets radial``
+reads r_FS, r_CS as rack shifts (``DriveGeometry.offset_direction``).
 
 Example (docs/fe-model.md, "Where the torque is carried"):
   OMP_NUM_THREADS=1 python benchmarks/bench_sweep.py --unit hd42 --base rFS_mm=0.016,rCS_mm=0.016 \\
@@ -58,7 +59,7 @@ def sweep(unit: str, base: dict[str, float], name: str, values: list[float], pre
                           symmetry="half")
         r = solve_lost_motion(g, mesh, steps_per_ramp=steps_per_ramp)
         rows.append({"unit": unit, **params, "interference_m": preload, "tip_relief": g.tip_relief,
-                     "deflection_coeff": g.deflection_coeff,
+                     "deflection_coeff": g.deflection_coeff, "offset_direction": g.offset_direction,
                      "status": r.status, "phi": r.lost_motion_arcmin, "phi_plus": r.phi_plus_arcmin,
                      "phi_minus": r.phi_minus_arcmin, "push_um": r.wg_deflection_um,
                      "teeth": r.teeth_in_contact, "loaded_arc_deg": r.loaded_arc_deg, "solve_s": r.solve_s})
@@ -82,12 +83,15 @@ if __name__ == "__main__":
                     help="DriveGeometry.deflection_coeff: the cam pushes this many w0 (> 1: a deeper cam)")
     ap.add_argument("--addendum-frac", type=float, default=None,
                     help="addendum / tooth height of FS and CS (default the unit's 0.45)")
+    ap.add_argument("--offsets", choices=("normal", "radial"), default="normal",
+                    help="DriveGeometry.offset_direction: r_FS, r_CS as normal flank offsets or rack shifts")
     ap.add_argument("--out", type=Path, default=None)
     a = ap.parse_args()
     name, _, vals = a.vary.partition("=")
     _check_names([name])
     df = sweep(a.unit, _assignments(a.base), name, [float(v) for v in vals.split(",")], a.preload, a.tip_relief,
                tuple(int(n) for n in a.mesh.split("x")), a.steps_per_ramp,
-               {"deflection_coeff": a.deflection, "addendum_frac": a.addendum_frac})
+               {"deflection_coeff": a.deflection, "addendum_frac": a.addendum_frac,
+                "offset_direction": a.offsets})
     if a.out is not None:
         df.to_csv(a.out, mode="a", header=not a.out.exists(), index=False)

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from hdwf.drive.geometry import (ARCMIN, cam_radius, cs_half_space_angle, drive_geometry, fs_half_angle,
+from hdwf.drive.cam import cam_radius
+from hdwf.drive.geometry import (ARCMIN, cs_half_space_angle, drive_geometry, fs_half_angle,
                                  geometric_backlash_arcmin, nominal_geometry)
 
 

@@ -62,10 +62,10 @@ def design_parameters(designs_path, design_id: str) -> dict[str, float]:
 
 
 def geometry_of(unit: str, params: Mapping[str, float], interference_m: float = 0.0,
-                tip_relief: float = 0.0, **shape: float) -> DriveGeometry:
+                tip_relief: float = 0.0, **shape) -> DriveGeometry:
     """The drive geometry of ``unit`` at the design parameters ``params`` (keys ``d_mm`` …), with
     the preloaded engagement and tip relief of ``drive_geometry`` (default: none); ``shape``
-    passes ``deflection_coeff`` / ``addendum_frac`` on."""
+    passes ``deflection_coeff``, ``addendum_frac`` and ``offset_direction`` on."""
     return drive_geometry(unit, params["d_mm"], params["D_mm"], params["Gr_mm"], params["rFS_mm"], params["rCS_mm"],
                           interference_m=interference_m, tip_relief=tip_relief, **shape)
 

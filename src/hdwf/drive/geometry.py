@@ -10,10 +10,11 @@ Contents
 * ``DriveGeometry``: a frozen dataclass holding everything the mesh and the solver need for
   one design (unit constants + the five design variables d, D, G_r, r_FS, r_CS + the cam).
 * ``drive_geometry(unit, d_mm, D_mm, Gr_mm, rFS_mm, rCS_mm)``: builds it.
-* the wave-generator cam of the paper's Eq. 3, R = A + B cos(2 (pi/2)(phi/(pi/2))^n),
-  with A, B solved numerically so that (1) the cam perimeter equals pi*d_nominal (the
-  inner-ring bore is inextensible and wraps the cam) and (2) the nominal design pushes the
-  flexspline (FS) out by w0 = m at the major axis (2-tooth difference).
+* the wave-generator cam of the paper's Eq. 3 (``hdwf.drive.cam``),
+  R = A + B cos(2 (pi/2)(phi/(pi/2))^n), with A, B solved numerically so that (1) the cam
+  perimeter equals pi*d_nominal (the inner-ring bore is inextensible and wraps the cam) and
+  (2) the nominal design pushes the flexspline (FS) out by deflection_coeff * w0 (w0 = m, the
+  2-tooth difference) at the major axis.
 * the tooth flanks: involutes (pressure angle alpha).  Why involute: it is the only profile
   whose normal offset is again the same profile rotated by offset/r_b, so a normal offset
   r_FS / r_CS maps to a *known* rigid-body backlash 2 (r_FS + r_CS) / r_b -- the analytic
@@ -53,8 +54,7 @@ import math
 from dataclasses import asdict, dataclass, replace
 
 import numpy as np
-from scipy.optimize import brentq
-
+from hdwf.drive.cam import cam_radius, size_cam
 from hdwf.drive.relief import tip_relief
 
 ARCMIN = math.pi / (180.0 * 60.0)  # rad per arcmin
@@ -312,44 +312,6 @@ def unit_data(unit: str) -> UnitData:
         return _UNIT_TABLE[unit.lower()]
     except KeyError:
         raise ValueError(f"unknown unit {unit!r}; expected one of {sorted(_UNIT_TABLE)}")
-
-
-# --------------------------------------------------------------------------------------
-# Cam, Eq. 3 of the paper
-# --------------------------------------------------------------------------------------
-def _fold(phi):
-    """Map any angle to [0, pi/2] with the cam's two mirror symmetries."""
-    p = np.mod(np.asarray(phi, dtype=float), np.pi)
-    return np.where(p > np.pi / 2, np.pi - p, p)
-
-
-def cam_radius(phi, A: float, B: float, n: float):
-    """R(phi) = A + B cos(2 (pi/2) (phi/(pi/2))^n), mirrored to the full circle."""
-    p = _fold(phi)
-    return A + B * np.cos(np.pi * (p / (np.pi / 2)) ** n)
-
-
-def cam_perimeter(A: float, B: float, n: float, npts: int = 20000) -> float:
-    """Perimeter of the closed cam curve (dense polyline, chord error ~1e-9 mm)."""
-    phi = np.linspace(0.0, np.pi / 2, npts + 1)
-    r = cam_radius(phi, A, B, n)
-    x, y = r * np.cos(phi), r * np.sin(phi)
-    return 4.0 * float(np.sum(np.hypot(np.diff(x), np.diff(y))))
-
-
-def cam_points(A: float, B: float, n: float, npts: int = 4096) -> np.ndarray:
-    """Closed polyline (npts x 2) of the cam, counter-clockwise from the major axis."""
-    phi = np.linspace(0.0, 2 * np.pi, npts, endpoint=False)
-    r = cam_radius(phi, A, B, n)
-    return np.column_stack([r * np.cos(phi), r * np.sin(phi)])
-
-
-def size_cam(d_nom: float, major_radius: float, n: float) -> tuple[float, float]:
-    """Solve A, B: perimeter = pi d_nom and A + B = major_radius (cam radius at phi = 0)."""
-    def res(B):
-        return cam_perimeter(major_radius - B, B, n) - math.pi * d_nom
-    B = brentq(res, 0.0, 0.2 * major_radius, xtol=1e-12)
-    return major_radius - B, B
 
 
 # --------------------------------------------------------------------------------------

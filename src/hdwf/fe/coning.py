@@ -47,7 +47,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from hdwf.drive.geometry import ARCMIN, DriveGeometry, size_cam
+from hdwf.drive.cam import size_cam
+from hdwf.drive.geometry import ARCMIN, DriveGeometry
 from hdwf.drive.mesh import DriveMesh
 from hdwf.fe.cycle import ZERO_TORQUE_BIAS, mount_wave_generator
 from hdwf.fe.model import LostMotionModel

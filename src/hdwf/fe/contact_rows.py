@@ -39,7 +39,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from hdwf.drive.geometry import DriveGeometry, cam_points
+from hdwf.drive.cam import cam_points
+from hdwf.drive.geometry import DriveGeometry
 from hdwf.fe.bodies import Body
 from hdwf.fe.contact_geometry import boundary_edge_normals, closest_on_cam, closest_segments
 from hdwf.fe.structure import Structure
