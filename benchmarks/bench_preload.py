@@ -28,6 +28,7 @@ import time
 from pathlib import Path
 
 import _one_thread  # noqa: F401,E402  (first: one BLAS thread, hdwf importable)
+from _shape_args import add_shape_arguments, shape_of
 
 import numpy as np
 import pandas as pd
@@ -146,17 +147,11 @@ if __name__ == "__main__":
                     help="zone half width (deg) for every run (default: by interference)")
     ap.add_argument("--mesh", default="5x3",
                     help="elements over the tooth height x thickness (10x6 is the studies' default)")
-    ap.add_argument("--deflection", type=float, default=1.0,
-                    help="DriveGeometry.deflection_coeff: the cam pushes this many w0 (> 1: a deeper cam)")
-    ap.add_argument("--addendum-frac", type=float, default=None,
-                    help="addendum / tooth height of FS and CS (default the unit's 0.45)")
-    ap.add_argument("--offsets", choices=("normal", "radial"), default="normal",
-                    help="DriveGeometry.offset_direction: r_FS, r_CS as normal flank offsets or rack shifts")
+    add_shape_arguments(ap)
     ap.add_argument("--summary-only", action="store_true")
     a = ap.parse_args()
     if not a.summary_only:
         solve_all(a.unit, _sets(a.sets), [float(x) for x in a.interference.split(",")], a.zone90,
                   a.out, a.tip_relief, a.zone, tuple(int(n) for n in a.mesh.split("x")),
-                  {"deflection_coeff": a.deflection, "addendum_frac": a.addendum_frac,
-                   "offset_direction": a.offsets})
+                  shape_of(a))
     summary(a.out)

@@ -21,6 +21,7 @@ import argparse
 from pathlib import Path
 
 import _one_thread  # noqa: F401,E402  (first: one BLAS thread, hdwf importable)
+from _shape_args import add_shape_arguments, shape_of
 
 import pandas as pd
 
@@ -79,19 +80,13 @@ if __name__ == "__main__":
     ap.add_argument("--tip-relief", type=float, default=PRELOAD_TIP_RELIEF)
     ap.add_argument("--mesh", default="10x6", help="elements over the tooth height x thickness")
     ap.add_argument("--steps-per-ramp", type=int, default=1)
-    ap.add_argument("--deflection", type=float, default=1.0,
-                    help="DriveGeometry.deflection_coeff: the cam pushes this many w0 (> 1: a deeper cam)")
-    ap.add_argument("--addendum-frac", type=float, default=None,
-                    help="addendum / tooth height of FS and CS (default the unit's 0.45)")
-    ap.add_argument("--offsets", choices=("normal", "radial"), default="normal",
-                    help="DriveGeometry.offset_direction: r_FS, r_CS as normal flank offsets or rack shifts")
+    add_shape_arguments(ap)
     ap.add_argument("--out", type=Path, default=None)
     a = ap.parse_args()
     name, _, vals = a.vary.partition("=")
     _check_names([name])
     df = sweep(a.unit, _assignments(a.base), name, [float(v) for v in vals.split(",")], a.preload, a.tip_relief,
                tuple(int(n) for n in a.mesh.split("x")), a.steps_per_ramp,
-               {"deflection_coeff": a.deflection, "addendum_frac": a.addendum_frac,
-                "offset_direction": a.offsets})
+               shape_of(a))
     if a.out is not None:
         df.to_csv(a.out, mode="a", header=not a.out.exists(), index=False)
