@@ -28,7 +28,8 @@ import time
 from pathlib import Path
 
 import _one_thread  # noqa: F401,E402  (first: one BLAS thread, hdwf importable)
-from _shape_args import add_shape_arguments, shape_of
+from _rows import append_rows
+from _cli import add_shape_arguments, shape_of
 
 import numpy as np
 import pandas as pd
@@ -82,7 +83,7 @@ def solve_all(unit: str, sets: list[int], interferences: list[float], zone90: bo
                    "phi_paper": row["lost_motion_arcmin"], "solve_s": r.solve_s, "mesh_s": mesh_s,
                    "teeth": r.teeth_in_contact, "pen_redetected_um": r.max_penetration_redetected_um,
                    "notes": r.notes, "loaded_arc_deg": r.loaded_arc_deg}
-            pd.DataFrame([rec]).to_csv(out, mode="a", header=not out.exists(), index=False)
+            append_rows(out, pd.DataFrame([rec]))
             print(f"{unit} set {s:2d} κ={g.deflection_coeff:g} δ={im:.2f} m zone {rec['zone_deg']:.0f}: {r.status} "
                   f"Φ {r.lost_motion_arcmin:.4f} (paper {row['lost_motion_arcmin']:.4f}) "
                   f"solve {r.solve_s:.1f} s teeth {r.teeth_in_contact} out to {r.loaded_arc_deg:.1f}° "

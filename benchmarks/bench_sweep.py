@@ -21,11 +21,11 @@ import argparse
 from pathlib import Path
 
 import _one_thread  # noqa: F401,E402  (first: one BLAS thread, hdwf importable)
-from _shape_args import add_shape_arguments, shape_of
+from _rows import append_rows
+from _cli import add_shape_arguments, assignments, check_names, shape_of
 
 import pandas as pd
 
-from hdwf import PARAMETER_COLUMNS
 from hdwf.drive.design import geometry_of
 from hdwf.drive.mesh import build_mesh
 from hdwf.drive.relief import PRELOAD_TIP_RELIEF
@@ -33,18 +33,6 @@ from hdwf.fe import solve_lost_motion
 from hdwf.study.paper import load_bounds
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def _check_names(names) -> None:
-    unknown = set(names) - set(PARAMETER_COLUMNS)
-    if unknown:
-        raise SystemExit(f"unknown design variable(s) {sorted(unknown)}; expected {PARAMETER_COLUMNS}")
-
-
-def _assignments(text: str) -> dict[str, float]:
-    pairs = dict(part.split("=", 1) for part in text.split(",") if part)
-    _check_names(pairs)
-    return {k: float(v) for k, v in pairs.items()}
 
 
 def sweep(unit: str, base: dict[str, float], name: str, values: list[float], preload: float,
@@ -84,9 +72,9 @@ if __name__ == "__main__":
     ap.add_argument("--out", type=Path, default=None)
     a = ap.parse_args()
     name, _, vals = a.vary.partition("=")
-    _check_names([name])
-    df = sweep(a.unit, _assignments(a.base), name, [float(v) for v in vals.split(",")], a.preload, a.tip_relief,
+    check_names([name])
+    df = sweep(a.unit, assignments(a.base), name, [float(v) for v in vals.split(",")], a.preload, a.tip_relief,
                tuple(int(n) for n in a.mesh.split("x")), a.steps_per_ramp,
                shape_of(a))
     if a.out is not None:
-        df.to_csv(a.out, mode="a", header=not a.out.exists(), index=False)
+        append_rows(a.out, df)

@@ -220,7 +220,13 @@ def test_a_deeper_cam_is_sized_to_push_kappa_w0():
     assert drive_geometry(*NOMINAL, deflection_coeff=1.0) == base and not base.preloaded
     assert deep.preloaded
     assert deep.r_cs_root - (deep.r_fs_tip + deep.w0) == pytest.approx((1 - 2 * 0.38) * 0.337, abs=1e-12)
-    for bad in ({"deflection_coeff": 0.9}, {"deflection_coeff": float("nan")}, {"addendum_frac": 0.6}):
+    # the major-axis pair overlaps by (kappa - 1) w0 sin(alpha) per flank (a locked pair: negative)
+    overlap = 0.4 * deep.w0 * math.sin(deep.alpha)
+    assert geometric_backlash_arcmin(deep) == pytest.approx(
+        geometric_backlash_arcmin(drive_geometry(*NOMINAL, interference_m=overlap / deep.module)), rel=1e-12)
+    # the relief is derived on the 2-tooth push's path only
+    for bad in ({"deflection_coeff": 0.9}, {"deflection_coeff": float("nan")}, {"addendum_frac": 0.6},
+                {"deflection_coeff": 1.2, "tip_relief": 1.1}):
         with pytest.raises(ValueError):
             drive_geometry(*NOMINAL, **bad)
 

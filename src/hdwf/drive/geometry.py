@@ -27,8 +27,8 @@ Contents
 * preloaded engagement (``interference_m``, units of m, default 0): the FS flanks are
   thickened by a normal offset interference_m * m, so the wave generator presses the
   teeth into the CS spaces (a preloaded wedge) and r_FS + r_CS first relieve that preload.
-* the other preload, a deeper cam (``deflection_coeff`` kappa = w0/m, default 1): the nominal
-  bearing pushes the FS out by kappa * w0, so the major-axis teeth sit (kappa - 1) m deeper in
+* the other preload, a deeper cam (``deflection_coeff`` kappa = push / w0, w0 = m, default 1):
+  the nominal bearing pushes the FS out by kappa * w0, so the major-axis teeth sit (kappa - 1) m deeper in
   their CS spaces than the flanks allow (an overlap of (kappa - 1) m sin(alpha) per flank) and
   only the teeth near the major axis are pressed in.  The tips then need more room than the
   0.1 h tip/root clearance of the default addenda: ``addendum_frac`` shortens both.
@@ -43,7 +43,7 @@ HD 120 design (offsets >= 25 um each).  The paper's Phi (0.18-1.49 / 0.64-2.51 a
 about ten times smaller than this kinematic bound, so its offsets cannot have opened
 clearance one-to-one; with the definition used here our Phi ranks the paper's designs
 well but its level is about ten times higher.  The cam is sized so that the *nominal*
-bearing (d_nom, D_nom, G_r,nom) gives w0 = m; bore clearance (d > d_nom), a loose FS fit
+bearing (d_nom, D_nom, G_r,nom) gives w0 = m (kappa w0 with a deeper cam); bore clearance (d > d_nom), a loose FS fit
 (D < D_nom) and a larger G_r give less deflection, i.e. extra radial clearance that opens
 dr sin(alpha) on each flank.
 """
@@ -54,6 +54,7 @@ import math
 from dataclasses import asdict, dataclass, replace
 
 import numpy as np
+
 from hdwf.drive.cam import cam_radius, size_cam
 from hdwf.drive.relief import tip_relief
 
@@ -227,7 +228,8 @@ class DriveGeometry:
     # ---- derived quantities -------------------------------------------------------
     @property
     def w0(self) -> float:
-        """Design radial deflection of the FS at the major axis (2-tooth difference)."""
+        """Radial deflection of the FS at the major axis that the 2-tooth difference asks for (m);
+        the cam pushes ``deflection_coeff`` times this."""
         return self.module * (self.z_cs - self.z_fs) / 2.0
 
     @property
@@ -357,13 +359,19 @@ def geometric_backlash_rad(g: DriveGeometry, radial_shortfall_mm: float = 0.0) -
 
     At the major axis the FS pitch point coincides with the CS pitch point P (radius
     r_pCS).  Both flanks are involutes through P with pressure angle alpha there, so the
-    normal clearance on each flank is r_FS + r_CS (+ radial_shortfall * sin(alpha) if the
-    FS does not reach the full deflection w0), and a rigid FS rotation psi about the drive
-    centre closes it at the rate |x_P x n| = r_pCS cos(alpha) = r_b,CS.  The FS can turn
-    both ways, so Phi = 2 (r_FS + r_CS + dr sin alpha) / r_b,CS.  A preload interference
-    delta enters as -delta (a negative result is a preloaded, rigidly locked pair).
+    normal clearance on each flank is the flank offsets of r_FS + r_CS (``flank_offsets``:
+    r_FS + r_CS, or (r_FS + r_CS) sin(alpha) for rack shifts), + radial_shortfall * sin(alpha)
+    if the FS does not reach the full deflection w0, and a rigid FS rotation psi about the
+    drive centre closes it at the rate |x_P x n| = r_pCS cos(alpha) = r_b,CS.  The FS can turn
+    both ways, so Phi = 2 (clearance) / r_b,CS.  A preload interference delta enters as
+    -delta, a deeper cam as -(kappa - 1) w0 sin(alpha) (a negative result is a preloaded,
+    rigidly locked pair).  With kappa > 1 a tooth off the axis touches first (its tangential
+    offset closes one flank faster than its withdrawal opens it), so the lost motion is then
+    below this major-axis value (tests/fe/test_preload.py, the rack path).
     """
-    gap = sum(g.flank_offsets) - g.interference + radial_shortfall_mm * math.sin(g.alpha)
+    gap = (sum(g.flank_offsets) - g.interference
+           - (g.deflection_coeff - 1.0) * g.w0 * math.sin(g.alpha)
+           + radial_shortfall_mm * math.sin(g.alpha))
     return 2.0 * gap / g.r_cs_base
 
 
@@ -412,6 +420,9 @@ def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: fl
         raise ValueError(f"offset_direction must be 'normal' or 'radial', got {offset_direction!r}")
     if not (1.0 <= deflection_coeff < 2.0):
         raise ValueError(f"deflection_coeff must be in [1, 2), got {deflection_coeff!r}")
+    if tip_relief and deflection_coeff != 1.0:
+        raise ValueError("tip_relief is derived on the path of the 2-tooth push (deflection_coeff 1); "
+                         f"got deflection_coeff={deflection_coeff!r} with tip_relief={tip_relief!r}")
     t = asdict(unit_data(unit))
     if addendum_frac is not None:
         if not (0.2 <= addendum_frac <= 0.5):
@@ -425,8 +436,8 @@ def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: fl
     r_cs_pitch = t["z_cs"] * m / 2
     w0 = m * (t["z_cs"] - t["z_fs"]) / 2
     # Cam: the nominal bearing (bore d_nom wrapped on the cam, radial clearance Gr_nom, OD
-    # = FS bore) must push the FS out by w0 at the major axis, rigid-body: A + B equals the
-    # bore radius + w0 + Gr_nom/2 (the ball gap on the loaded side).
+    # = FS bore) must push the FS out by kappa w0 at the major axis, rigid-body: A + B equals
+    # the bore radius + kappa w0 + Gr_nom/2 (the ball gap on the loaded side).
     A, B = size_cam(t["d_nom"], t["d_nom"] / 2 + deflection_coeff * w0 + t["Gr_nom"] / 2,
                     t["cam_n"])
     return DriveGeometry(

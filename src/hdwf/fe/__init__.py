@@ -17,7 +17,8 @@ Phi = phi + phi'.  The modules, from the bottom up:
 * ``solver``: the active-set contact solver of one load level;
 * ``relinearise``: the tooth and cam rows re-detected at a solved state until they agree;
 * ``model``: ``LostMotionModel``, which assembles the pieces for one design;
-* ``preload``: the preload ramp that mounts preloaded teeth (``interference_m``), and the
+* ``preload``: the preload ramp that mounts preloaded teeth (``DriveGeometry.preloaded``: a flank
+  allowance ``interference_m`` or a deeper cam ``deflection_coeff``), and the
   check of the teeth outside the watched zones;
 * ``cycle``: the test itself, ``solve_lost_motion`` and ``solve_lost_motion_variants``.
 

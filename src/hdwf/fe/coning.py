@@ -71,9 +71,10 @@ def slice_pushes(coning: float, n_slices: int) -> np.ndarray:
 
 
 def coned_geometry(geom: DriveGeometry, push: float) -> DriveGeometry:
-    """``geom`` with the cam re-sized to push the nominal bearing out by ``push`` w0."""
-    w0 = geom.module * (geom.z_cs - geom.z_fs) / 2     # as ``drive_geometry`` (k = 1: same cam)
-    A, B = size_cam(geom.d_nom, geom.d_nom / 2 + push * w0 + geom.Gr_nom / 2, geom.cam_n)
+    """``geom`` with the cam re-sized to push the nominal bearing out by ``push`` times the
+    design's own push (``deflection_coeff`` w0; k = 1: the same cam)."""
+    design_push = geom.deflection_coeff * geom.w0      # as ``drive_geometry``
+    A, B = size_cam(geom.d_nom, geom.d_nom / 2 + push * design_push + geom.Gr_nom / 2, geom.cam_n)
     return replace(geom, cam_A=A, cam_B=B)
 
 

@@ -27,7 +27,7 @@ from hdwf.fe.working_set import WorkingSet
 
 
 ZONE_DEG = 35.0   # half width (deg) of the tooth zones about the major axes solved by default
-# with a preload (interference_m > 0), an active-set iterate that swings a loaded free mode so
+# with a preload (``DriveGeometry.preloaded``), an active-set iterate that swings a loaded free mode so
 # far that a pair open before is penetrated by more than this (units of the module m: a quarter
 # of it, beyond the range the linearised tooth rows stand for) is cut back to the first closing
 # pair (``solver``)

@@ -1,9 +1,12 @@
-"""Command-line options for the section's shape alternatives (``drive_geometry`` keywords),
-shared by the benchmarks that solve Tables 4/5 or sweep one design."""
+"""Command-line pieces shared by the benchmarks that solve Tables 4/5 or one design: the
+section's shape alternatives (``drive_geometry`` keywords) and design variables given as
+NAME=value pairs."""
 
 from __future__ import annotations
 
 import argparse
+
+from hdwf import PARAMETER_COLUMNS
 
 
 def add_shape_arguments(ap: argparse.ArgumentParser) -> None:
@@ -20,3 +23,17 @@ def shape_of(args: argparse.Namespace) -> dict:
     """The ``drive_geometry`` keywords the options ask for."""
     return {"deflection_coeff": args.deflection, "addendum_frac": args.addendum_frac,
             "offset_direction": args.offsets}
+
+
+def check_names(names) -> None:
+    """Refuse names that are not design variables (``hdwf.PARAMETER_COLUMNS``)."""
+    unknown = set(names) - set(PARAMETER_COLUMNS)
+    if unknown:
+        raise SystemExit(f"unknown design variable(s) {sorted(unknown)}; expected {PARAMETER_COLUMNS}")
+
+
+def assignments(text: str) -> dict[str, float]:
+    """``"rFS_mm=0.016,rCS_mm=0"`` -> ``{"rFS_mm": 0.016, "rCS_mm": 0.0}`` (checked names)."""
+    pairs = dict(part.split("=", 1) for part in text.split(",") if part)
+    check_names(pairs)
+    return {k: float(v) for k, v in pairs.items()}
