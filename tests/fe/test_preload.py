@@ -10,7 +10,7 @@ from functools import cache
 import numpy as np
 import pytest
 
-from hdwf.drive.geometry import drive_geometry, fs_half_angle, geometric_backlash_arcmin
+from hdwf.drive.geometry import ARCMIN, drive_geometry, fs_half_angle, geometric_backlash_arcmin
 from hdwf.drive.mesh import build_mesh
 from hdwf.fe import LostMotionModel, preload, solve_lost_motion
 from hdwf.fe.contact_rows import stack_rows, tooth_rows
@@ -242,7 +242,7 @@ def _rack_path_backlash_arcmin(g, kappa):
     m, a = g.module, g.alpha
     s = 0.5 * m * (2 * phi - kappa * g.tilt_factor * np.sin(2 * phi))
     gap = g.r_fs + g.r_cs - (kappa * np.cos(2 * phi) - 1) * m * math.sin(a) - np.abs(s) * math.cos(a)
-    return 2 * float(gap.min()) / g.r_cs_base / (math.pi / 180 / 60)
+    return 2 * float(gap.min()) / g.r_cs_base / ARCMIN
 
 
 @pytest.mark.parametrize("kappa", [1.0, 1.4])

@@ -1,8 +1,9 @@
 """The wave-generator cam of the paper's Eq. 3: R = A + B cos(2 (pi/2) (phi/(pi/2))^n).
 
-Its radius, perimeter and polyline, and ``size_cam``, which solves A and B so that the
-inner ring's bore (inextensible, pi d_nom long) wraps the cam and the cam reaches a given
-radius at the major axis.  Units: mm, rad.
+Its radius, perimeter and polyline; ``size_cam``, which solves A and B so that the inner
+ring's bore (inextensible, pi d_nom long) wraps the cam and the cam reaches a given radius at
+the major axis; and ``cam_for_push``, the cam with which the nominal bearing pushes the
+flexspline out by a given amount.  Units: mm, rad.
 """
 
 from __future__ import annotations
@@ -46,3 +47,10 @@ def size_cam(d_nom: float, major_radius: float, n: float) -> tuple[float, float]
         return cam_perimeter(major_radius - B, B, n) - math.pi * d_nom
     B = brentq(res, 0.0, 0.2 * major_radius, xtol=1e-12)
     return major_radius - B, B
+
+
+def cam_for_push(d_nom: float, Gr_nom: float, push: float, n: float) -> tuple[float, float]:
+    """A, B of the cam with which the nominal bearing (bore d_nom wrapped on the cam, radial
+    clearance Gr_nom, OD = FS bore) pushes the FS out by ``push`` at the major axis, rigid-body:
+    A + B is the bore radius + push + Gr_nom/2 (the ball gap on the loaded side)."""
+    return size_cam(d_nom, d_nom / 2 + push + Gr_nom / 2, n)

@@ -55,7 +55,7 @@ from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
-from hdwf.drive.cam import cam_radius, size_cam
+from hdwf.drive.cam import cam_for_push, cam_radius
 from hdwf.drive.relief import tip_relief
 
 ARCMIN = math.pi / (180.0 * 60.0)  # rad per arcmin
@@ -435,11 +435,7 @@ def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: fl
     r_fs_pitch = t["z_fs"] * m / 2
     r_cs_pitch = t["z_cs"] * m / 2
     w0 = m * (t["z_cs"] - t["z_fs"]) / 2
-    # Cam: the nominal bearing (bore d_nom wrapped on the cam, radial clearance Gr_nom, OD
-    # = FS bore) must push the FS out by kappa w0 at the major axis, rigid-body: A + B equals
-    # the bore radius + kappa w0 + Gr_nom/2 (the ball gap on the loaded side).
-    A, B = size_cam(t["d_nom"], t["d_nom"] / 2 + deflection_coeff * w0 + t["Gr_nom"] / 2,
-                    t["cam_n"])
+    A, B = cam_for_push(t["d_nom"], t["Gr_nom"], deflection_coeff * w0, t["cam_n"])
     return DriveGeometry(
         unit=unit.lower(), d=float(d_mm), D=float(D_mm), Gr=float(Gr_mm),
         r_fs=float(rFS_mm), r_cs=float(rCS_mm),

@@ -47,7 +47,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from hdwf.drive.cam import size_cam
+from hdwf.drive.cam import cam_for_push
 from hdwf.drive.geometry import ARCMIN, DriveGeometry
 from hdwf.drive.mesh import DriveMesh
 from hdwf.fe.cycle import ZERO_TORQUE_BIAS, mount_wave_generator
@@ -73,8 +73,7 @@ def slice_pushes(coning: float, n_slices: int) -> np.ndarray:
 def coned_geometry(geom: DriveGeometry, push: float) -> DriveGeometry:
     """``geom`` with the cam re-sized to push the nominal bearing out by ``push`` times the
     design's own push (``deflection_coeff`` w0; k = 1: the same cam)."""
-    design_push = geom.deflection_coeff * geom.w0      # as ``drive_geometry``
-    A, B = size_cam(geom.d_nom, geom.d_nom / 2 + push * design_push + geom.Gr_nom / 2, geom.cam_n)
+    A, B = cam_for_push(geom.d_nom, geom.Gr_nom, push * (geom.deflection_coeff * geom.w0), geom.cam_n)
     return replace(geom, cam_A=A, cam_B=B)
 
 
