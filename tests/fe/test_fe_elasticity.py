@@ -7,7 +7,8 @@ import pytest
 
 from hdwf.drive.geometry import drive_geometry
 from hdwf.drive.mesh import annulus_mesh
-from hdwf.fe import ball_compliance_coeff, edge_loads, hertz_point_contact, solve_linear
+from hdwf.fe import (ball_compliance_coeff, ball_max_pressure, edge_loads,
+                     hertz_max_pressure, hertz_point_contact, solve_linear)
 
 E, NU = 210_000.0, 0.3
 
@@ -94,3 +95,31 @@ def test_hertz_ball_in_groove_vs_hamrock_brewe():
     # the HD 42 ball (inner + outer contact in series) at 14 N approaches ~1.6 um
     g = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.0, 0.0)
     assert ball_compliance_coeff(g) * 14.0 ** (2 / 3) == pytest.approx(1.64e-3, rel=0.05)
+
+
+def test_hertz_pressure_sphere_on_flat_matches_closed_form():
+    """Sphere (R = 2 mm) on a flat: p0 = (6 P E*^2 / (pi^3 R^2))^(1/3) (Johnson, Contact
+    Mechanics, eq. 4.24), within 1e-9 for P = 1..100 N; no load, no pressure."""
+    R = 2.0
+    Es = E / (2 * (1 - NU ** 2))
+    for P in (1.0, 10.0, 100.0):
+        assert hertz_max_pressure(1 / R, 1 / R, E, NU, P) == pytest.approx(
+            (6 * P * Es ** 2 / (math.pi ** 3 * R ** 2)) ** (1 / 3), rel=1e-9)
+    assert hertz_max_pressure(1 / R, 1 / R, E, NU, 0.0) == 0.0
+
+
+def test_hertz_pressure_of_a_ball_in_its_groove_agrees_with_its_approach():
+    """Elliptical contact (HD 42 ball in its inner groove, k = 8.7): Johnson's delta = K(e) p0 b / E*
+    ties the pressure to the approach the solver uses (``hertz_point_contact``, tested above):
+    within 1e-9. A ball's pressure grows as P^(1/3)."""
+    from scipy.special import ellipk
+    rb, rg, rr = 3.969 / 2, 0.52 * 3.969, 33.10 / 2
+    rho_x, rho_y = 1 / rb + 1 / rr, 1 / rb - 1 / rg
+    P = 20.0
+    c, k = hertz_point_contact(rho_x, rho_y, E, NU)
+    p0 = hertz_max_pressure(rho_x, rho_y, E, NU, P)
+    Ep = E / (1 - NU ** 2)
+    b = math.sqrt(3 * P / (2 * math.pi * k * p0))      # p0 = 3 P / (2 pi a b), a = k b
+    assert c * P ** (2 / 3) == pytest.approx(float(ellipk(1 - 1 / k ** 2)) * p0 * b / (Ep / 2), rel=1e-9)
+    g = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.0, 0.0)
+    assert ball_max_pressure(g, 8 * P) == pytest.approx(2 * ball_max_pressure(g, P), rel=1e-12)

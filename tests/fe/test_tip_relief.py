@@ -13,7 +13,7 @@ import pytest
 from hdwf.drive.geometry import cs_half_space_angle, drive_geometry, fs_half_angle
 from hdwf.drive.mesh import build_mesh
 from hdwf.drive.relief import PRELOAD_TIP_RELIEF, relief_start_depth, tip_relief
-from hdwf.fe import LostMotionModel, solve_lost_motion
+from hdwf.fe import ISO76_BALL_PRESSURE_MPA, LostMotionModel, ball_max_pressure, solve_lost_motion
 from hdwf.fe.cycle import mount_wave_generator
 
 COARSE = {"elements_over_height": 5, "elements_over_thickness": 3, "symmetry": "half"}
@@ -113,7 +113,9 @@ def test_loaded_arc_shows_where_the_torque_is_carried():
     (a few teeth within 20°); HD 42's loosest bearing of Table 3 (d, D, G_r at their clearance
     bounds) with zero offsets and a heavy allowance pushes the FS so far back that teeth all
     round, out to the minor axis, are loaded: the exit-zone tip crossings the diagnostic is
-    there to show (docs/fe-model.md, "The studies' model")."""
+    there to show (docs/fe-model.md, "The studies' model").  The tight design's preload loads
+    its most loaded wave-generator ball beyond ISO 76's static rating (4200 MPa); the open one's
+    balls carry only the FS ring's bending, tens of newtons."""
     g_open = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.02, 0.02, interference_m=0.17,
                             tip_relief=PRELOAD_TIP_RELIEF)
     r_open = solve_lost_motion(g_open, build_mesh(g_open, **COARSE), steps_per_ramp=1)
@@ -123,3 +125,6 @@ def test_loaded_arc_shows_where_the_torque_is_carried():
     assert r_open.status == r_tight.status == "ok"
     assert r_open.loaded_arc_deg < 20.0 and r_open.teeth_in_contact <= 12
     assert r_tight.loaded_arc_deg > 60.0 and r_tight.teeth_in_contact > 100
+    assert r_open.max_ball_load_N < 50.0 and r_open.max_ball_pressure_MPa < ISO76_BALL_PRESSURE_MPA
+    assert r_tight.max_ball_pressure_MPa > ISO76_BALL_PRESSURE_MPA
+    assert r_tight.max_ball_pressure_MPa == pytest.approx(ball_max_pressure(g_tight, r_tight.max_ball_load_N))

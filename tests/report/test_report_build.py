@@ -158,3 +158,15 @@ def test_agreement_section_labels_the_blind_drive_and_its_misses(named_inputs, t
     assert row[:2] == ["HD 42 (blind)", "27 of 27"] and row[2] == "1.0000" and row[7] == f"{scale:.2f}"
     text = " ".join(b.get("text", "") for b in doc.blocks if b["type"] == "text")
     assert said in text and "preloaded" in text.lower() and "0.147" in text
+
+
+def test_ball_load_sentence_holds_the_mount_against_iso_76():
+    """The FE part states the most loaded wave-generator ball against ISO 76's 4200 MPa, and counts
+    the designs above it; a study without the columns (an older run) says nothing."""
+    import pandas as pd
+    from hdwf.report.fe_part import _ball_load
+    lm = pd.DataFrame({"ball_load_max_N": [12.0, 700.0, 2200.0], "ball_pressure_max_MPa": [890.0, 3460.0, 5090.0]})
+    said = _ball_load(lm)
+    assert "12–2200 N" in said and "890–5090 MPa" in said and "in 1 of 3 designs above the 4200 MPa" in said
+    assert "within the 4200 MPa" in _ball_load(lm.iloc[:2])
+    assert _ball_load(pd.DataFrame({"lost_motion_arcmin": [1.0]})) == ""

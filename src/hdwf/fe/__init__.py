@@ -7,7 +7,7 @@ the FS rim; the result is the torque-twist curve, phi (+T), phi' (-T) and the lo
 Phi = phi + phi'.  The modules, from the bottom up:
 
 * ``changes``: ``ModelChanges``, the physical additions to the baseline model;
-* ``hertz``: the Hertz law of a bearing ball;
+* ``hertz``: the Hertz law of a bearing ball and its contact pressure;
 * ``bodies``: plane-stress stiffness, factorisation, rigid modes and half-model ties;
 * ``structure``: the bodies seen through the watch vector, the torque load and twist measure;
 * ``contact_geometry`` and ``contact_rows``: closest points and normals on the contact
@@ -42,11 +42,13 @@ from hdwf.fe.bodies import assemble_stiffness, edge_loads, plane_stress_lame, so
 from hdwf.fe.changes import ModelChanges
 from hdwf.fe.cycle import (LostMotionResult, series_output_twist, solve_lost_motion,
                            solve_lost_motion_variants, torque_fractions)
-from hdwf.fe.hertz import ball_compliance_coeff, hertz_point_contact
+from hdwf.fe.hertz import (ISO76_BALL_PRESSURE_MPA, ball_compliance_coeff, ball_max_pressure,
+                            hertz_max_pressure, hertz_point_contact)
 from hdwf.fe.model import LostMotionModel
 from hdwf.fe.solver import ContactFailure
 
-__all__ = ["ContactFailure", "LostMotionModel", "LostMotionResult", "ModelChanges", "assemble_stiffness",
-           "ball_compliance_coeff", "edge_loads", "hertz_point_contact", "plane_stress_lame",
+__all__ = ["ISO76_BALL_PRESSURE_MPA", "ContactFailure", "LostMotionModel", "LostMotionResult", "ModelChanges",
+           "assemble_stiffness", "ball_compliance_coeff", "ball_max_pressure", "edge_loads", "hertz_max_pressure",
+           "hertz_point_contact", "plane_stress_lame",
            "series_output_twist", "solve_linear", "solve_lost_motion", "solve_lost_motion_variants",
            "torque_fractions"]

@@ -35,6 +35,7 @@ from hdwf.drive.geometry import ARCMIN, DriveGeometry
 from hdwf.drive.mesh import DriveMesh
 from hdwf.fe.changes import ModelChanges
 from hdwf.fe.contact_rows import ball_rows, cam_rows, fit_rows, tooth_rows
+from hdwf.fe.hertz import ball_max_pressure
 from hdwf.fe.model import ZONE_DEG, LostMotionModel
 from hdwf.fe.preload import PRELOAD_ZONE_DEG, mount_preloaded, overlap_outside_zones
 from hdwf.fe.relinearise import redetect_teeth, settle_teeth
@@ -65,6 +66,8 @@ class LostMotionResult:
     max_penetration_redetected_um: float = float("nan")  # tooth pairs re-found at +-T
     overlap_outside_zones_um: float = float("nan")  # teeth outside the zones, at the mount
     loaded_arc_deg: float = float("nan")   # largest angle from a major axis of a tooth loaded at +T
+    max_ball_load_N: float = float("nan")   # the most loaded wave-generator ball at the mount
+    max_ball_pressure_MPa: float = float("nan")  # its raceway contact pressure (ISO 76 rates 4200)
     notes: str = ""
     fields: dict | None = None   # with keep_fields: {"wg": {...}, "plus": {...}} body -> (2, n) mm
 
@@ -296,6 +299,8 @@ def _result(model: LostMotionModel, changes: ModelChanges, frac: np.ndarray,
     km = int(np.argmin(np.abs(frac + 1.0)))
     phi_p, phi_m = float(tw[kp]), float(-tw[km])
     maxpen_nl = test.max_penetration_redetected
+    mount = mounted.solution
+    ball_N = float(mount.normal_force[[k == "ball" for k, _ in mount.pair_ids]].max(initial=0.0))
     return LostMotionResult(
         phi_plus_arcmin=phi_p, phi_minus_arcmin=phi_m,
         lost_motion_arcmin=phi_p + phi_m, step=np.arange(frac.size),
@@ -305,6 +310,7 @@ def _result(model: LostMotionModel, changes: ModelChanges, frac: np.ndarray,
         factorize_s=model.factorize_s, n_dofs=model.n_dofs, wg_deflection_um=mounted.deflection_um,
         max_penetration_redetected_um=max(0.0, maxpen_nl) * 1000.0,
         overlap_outside_zones_um=mounted.outside_overlap_um, loaded_arc_deg=test.loaded_arc_deg,
+        max_ball_load_N=ball_N, max_ball_pressure_MPa=ball_max_pressure(model.geometry, ball_N, model.material.E),
         notes=(f"zero-torque steps at {ZERO_TORQUE_BIAS:g} T_test towards the last load; "
                f"tooth penetration re-detected at the deformed state at +-T: "
                f"{max(0.0, maxpen_nl) * 1000:.4f} um; teeth outside the solved zones overlap by "

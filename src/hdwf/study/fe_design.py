@@ -45,6 +45,7 @@ def solve_design(unit: str, params: Mapping[str, float], mesh: DriveMesh, steps_
            "teeth_in_contact": int(res.teeth_in_contact), "max_penetration_um": float(res.max_penetration_um),
            "overlap_outside_zones_um": float(res.overlap_outside_zones_um),
            "loaded_arc_deg": float(res.loaded_arc_deg),
+           "ball_load_max_N": float(res.max_ball_load_N), "ball_pressure_max_MPa": float(res.max_ball_pressure_MPa),
            "iterations": int(res.iterations), "n_dofs": int(res.n_dofs), "solve_s": float(res.solve_s),
            "factorize_s": float(res.factorize_s), "h_tooth_mm": float(mesh.sizes.get("tooth", np.nan))}
     curve = pd.DataFrame({"design_id": design_id, "step": np.asarray(res.step, dtype="int64"),
