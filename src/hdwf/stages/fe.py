@@ -17,7 +17,6 @@ from hdwf import PARAMETER_COLUMNS
 from hdwf.common.io import atomic_path, read_parquet_meta, write_parquet
 from hdwf.drive.design import (MeshSettings, design_parameters, geometry_of, load_drive_mesh, save_drive_mesh)
 from hdwf.fe import solve_lost_motion
-from hdwf.report.figures import deformed_figure
 from hdwf.study.aggregate import write_lost_motion
 from hdwf.study.convergence import convergence_table
 from hdwf.study.fe_design import solve_design
@@ -120,6 +119,7 @@ def deformed_stage(designs_path, design_id: str, unit: str, settings: Mapping, s
         with open(tmp, "wb") as fh:
             np.savez_compressed(fh, **arrays)
     pitch = 2 * np.pi * geom.r_fs_pitch / geom.z_fs
+    from hdwf.report.figures import deformed_figure   # matplotlib only here: the per-design jobs start faster
     deformed_figure(mesh, res.fields, f"{unit} {design_id} at +4 % T_N (Φ = {res.lost_motion_arcmin:.3f} arcmin), "
                     "true scale", out_png, half_width_mm=2.5 * pitch,
                     xlim=(geom.r_fs_bore - 2 * geom.module, geom.r_cs_root + 3 * geom.module))

@@ -6,18 +6,23 @@ Each stage reads its inputs, calls ``hdwf.validation`` and writes what its rule 
 
 from __future__ import annotations
 
+# The figures (matplotlib) and the diagnosis (statsmodels) are imported by the stages that use
+# them: the 70 specimen jobs of a default run then start a second faster each.
+
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pandas as pd
 
 from hdwf.common.io import read_json, write_json, write_parquet
-from hdwf.report.figures import ladder_figure, measured_vs_predicted_figure, residual_figure
-from hdwf.validation.diagnosis import Search, diagnose
 from hdwf.validation.jsonsafe import json_safe
 from hdwf.validation.ladder import ladder_variants, solve_ladder
 from hdwf.validation.measurements import MeasurementError, load_measurements, schedule_problems
 from hdwf.validation.variants import SolveSetup, candidate_names, plan_variants, solve_specimen, specimen_solver
+
+if TYPE_CHECKING:
+    from hdwf.validation.diagnosis import Search
 
 
 @dataclass
@@ -40,6 +45,7 @@ class CampaignPlan:
 
     def search(self) -> Search:
         """What its diagnosis searches."""
+        from hdwf.validation.diagnosis import Search
         return Search(self.fixed, self.calibrate_first, self.candidates, self.rounds)
 
     def solve_setup(self, jobs: int = 1) -> SolveSetup:
@@ -197,6 +203,7 @@ def diagnosis_stage(plan: CampaignPlan, inputs: CampaignInputs, out_json, out_po
     """
     meas, table = inputs.read()
     solve = specimen_solver(plan.solve_setup(jobs), meas.specimens)
+    from hdwf.validation.diagnosis import diagnose
     diagnosis = diagnose(meas, table, plan.search(), solve=solve)
     result = json_safe({"campaign": plan.name, "unit": plan.unit, "measurements": str(inputs.measurements),
                         "mesh": plan.settings, **diagnosis.to_dict(), "provenance": provenance})
@@ -248,6 +255,7 @@ def figures_stage(diagnosis_json, points, ladder, out_measured, out_residuals, o
     diag = read_json(diagnosis_json)
     pts = pd.read_parquet(points)
     name = f"{diag['campaign']} ({diag['unit'].upper()})"
+    from hdwf.report.figures import ladder_figure, measured_vs_predicted_figure, residual_figure
     measured_vs_predicted_figure(pts, f"{name}: measured against predicted", out_measured)
     residual_figure(pts, f"{name}: residuals", out_residuals)
     ladder_figure(pd.read_parquet(ladder), diag.get("noise_arcmin"), f"{name}: the error ladder", out_ladder)

@@ -14,8 +14,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-import statsmodels.api as sm
-from statsmodels.stats.diagnostic import linear_reset
 
 from hdwf import PARAMETER_COLUMNS
 
@@ -142,6 +140,10 @@ def residual_tests(points: pd.DataFrame) -> pd.DataFrame:
     pandas.DataFrame
         One row per test: ``test``, ``statistic``, ``p_value``, ``meaning``.
     """
+    # statsmodels here only: the specimen and ladder jobs, which never test residuals, start faster
+    import statsmodels.api as sm
+    from statsmodels.stats.diagnostic import linear_reset
+
     rows = []
     spec = points.groupby("specimen_id", sort=False).agg(E=("E", "mean"), **{c: (c, "first") for c in PARAMETER_COLUMNS})
     X = spec[list(PARAMETER_COLUMNS)].to_numpy(float)
