@@ -3,7 +3,8 @@
 Solves each design of the paper's table (coarse half mesh, 5 x 3 elements per tooth, as the
 tests use; 5 steps per ramp) at every ``--interference`` (units of the module m) and appends
 one row per solve to ``--out`` (CSV: unit, set, interference_m, mesh, zone_deg, status, Phi, the
-paper's Phi, solve and mesh seconds, teeth in contact, the ramp's overlap).  Interference 0
+paper's Phi, solve and mesh seconds, teeth in contact, the ramp's overlap, the most loaded
+wave-generator ball at the mount and its raceway pressure).  Interference 0
 runs at today's 35 deg zones; ``--zone90`` adds interference 0 with every tooth watched (the
 zones a preload uses), which separates the zone from the preload.  Then it prints, per
 interference: the median ratio ours/paper, Spearman, and dPhi/dr_FS by least squares over
@@ -37,7 +38,7 @@ from scipy.stats import spearmanr
 
 from hdwf.drive.geometry import drive_geometry
 from hdwf.drive.mesh import build_mesh
-from hdwf.fe import solve_lost_motion
+from hdwf.fe import ISO76_BALL_PRESSURE_MPA, solve_lost_motion
 from hdwf.fe.cycle import EXIT_ARC_DEG
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -82,12 +83,13 @@ def solve_all(unit: str, sets: list[int], interferences: list[float], zone90: bo
                    "reason": r.reason[:200], "phi": r.lost_motion_arcmin,
                    "phi_paper": row["lost_motion_arcmin"], "solve_s": r.solve_s, "mesh_s": mesh_s,
                    "teeth": r.teeth_in_contact, "pen_redetected_um": r.max_penetration_redetected_um,
-                   "notes": r.notes, "loaded_arc_deg": r.loaded_arc_deg}
+                   "notes": r.notes, "loaded_arc_deg": r.loaded_arc_deg,
+                   "ball_load_max_N": r.max_ball_load_N, "ball_pressure_max_MPa": r.max_ball_pressure_MPa}
             append_rows(out, pd.DataFrame([rec]))
             print(f"{unit} set {s:2d} κ={g.deflection_coeff:g} δ={im:.2f} m zone {rec['zone_deg']:.0f}: {r.status} "
                   f"Φ {r.lost_motion_arcmin:.4f} (paper {row['lost_motion_arcmin']:.4f}) "
                   f"solve {r.solve_s:.1f} s teeth {r.teeth_in_contact} out to {r.loaded_arc_deg:.1f}° "
-                  f"{r.reason[:120]}", flush=True)
+                  f"ball {r.max_ball_load_N:.0f} N {r.max_ball_pressure_MPa:.0f} MPa {r.reason[:120]}", flush=True)
 
 
 def _slope(table: pd.DataFrame, sets, phi: np.ndarray) -> float:
@@ -132,7 +134,11 @@ def summary(out: Path):
                   f"dΦ/dr_FS {a['slope']:.4f} ({a['paper_slope']:.4f}) arcmin/µm, "
                   f"solve median {ok.solve_s.median():.1f} s (max {ok.solve_s.max():.1f})"
                   + (f", loaded beyond {EXIT_ARC_DEG:g}° on {int((ok.loaded_arc_deg > EXIT_ARC_DEG).sum())}"
-                     if "loaded_arc_deg" in ok and ok.loaded_arc_deg.notna().any() else ""))
+                     if "loaded_arc_deg" in ok and ok.loaded_arc_deg.notna().any() else "")
+                  + (f", ball pressure at the mount {ok.ball_pressure_max_MPa.min():.0f}–"
+                     f"{ok.ball_pressure_max_MPa.max():.0f} MPa, above ISO 76's {ISO76_BALL_PRESSURE_MPA:g} on "
+                     f"{int((ok.ball_pressure_max_MPa > ISO76_BALL_PRESSURE_MPA).sum())}"
+                     if "ball_pressure_max_MPa" in ok and ok.ball_pressure_max_MPa.notna().any() else ""))
 
 
 if __name__ == "__main__":
