@@ -136,9 +136,9 @@ def _ball_load(lm: pd.DataFrame) -> str:
             f"(median {fmt(load.median(), 0)} N), a raceway pressure of {fmt(pressure.min(), 0)}–"
             f"{fmt(pressure.max(), 0)} MPa")
     if not over.any():
-        return text + f", within the {ISO76_BALL_PRESSURE_MPA:g} MPa of ISO 76's static rating. "
+        return text + f", within the {ISO76_BALL_PRESSURE_MPA:g} MPa of the static rating of ISO 76. "
     return (text + f"; in {int(over.sum())} of {len(lm)} designs above the {ISO76_BALL_PRESSURE_MPA:g} MPa of "
-            "ISO 76's static rating, where the raceways dent: a drive preloaded that hard would be damaged at "
+            "the static rating of ISO 76, where the raceways dent: a drive preloaded that hard would be damaged at "
             "assembly, so the allowance cannot be read as a real interference of the drive "
             "(docs/fe-model.md, \"The studies' model\"). ")
 
