@@ -57,3 +57,33 @@ def test_parallel_combination_is_exact_on_piecewise_linear_slices():
     assert theta == pytest.approx(expect, abs=coning.THETA_TOL)
     theta_m, _ = coupled_twist(slices, -T)
     assert theta_m == pytest.approx(-expect, abs=coning.THETA_TOL)
+
+
+class _Crossed(_Analytic):
+    """A locked slice whose two sides end in states that cross by ``c`` near zero torque:
+    twist = T / K - c sign T (the -bias state lies above the +bias one), as a preloaded slice
+    reached on separate paths from the mount does at the contact tolerance."""
+
+    def __init__(self, K, c):
+        super().__init__(K, -c)
+
+
+def test_each_side_combines_its_own_relation():
+    """A crossing of 2 THETA_TOL between the sides' bias states is no failure: at +T only the
+    + side's states count. Two slices (K1 crossed, K2 with backlash b): at +T the common twist
+    solves (K1 (theta + c) + K2 max(0, theta - b)) / 2 = T."""
+    T = 960.0
+    K1, K2, b, c = 2.0e6, 3.0e6, 0.3 * ARCMIN, 2 * coning.THETA_TOL
+    slices = [_Crossed(K1, c), _Analytic(K2, b)]
+    for s in slices:
+        for f in coning.SAMPLE_FRACTIONS:
+            s.solve(f * T)
+            s.solve(-f * T)
+    mixed = np.array(slices[0].twist)[np.argsort(slices[0].torque)]
+    assert np.diff(mixed).min() < -coning.THETA_TOL    # both sides in one relation: not monotone
+    theta, _ = coupled_twist(slices, T)
+    th1 = 2 * T / K1 - c
+    expect = th1 if th1 <= b else (2 * T - K1 * c + K2 * b) / (K1 + K2)
+    assert theta == pytest.approx(expect, abs=coning.THETA_TOL)
+    theta_m, _ = coupled_twist(slices, -T)
+    assert theta_m == pytest.approx(-expect, abs=coning.THETA_TOL)

@@ -98,12 +98,23 @@ class SliceCurve:
         self.levels += 1
         return float(level.twist)
 
-    def relation(self) -> tuple[np.ndarray, np.ndarray]:
-        """The sampled relation sorted by torque: (theta, T'); raises if not monotone."""
-        order = np.argsort(self.torque)
-        T, th = np.array(self.torque)[order], np.array(self.twist)[order]
-        if np.any(np.diff(th) < -THETA_TOL):
-            raise ContactFailure(f"coning: slice k={self.push:.4f} twist not monotone in torque")
+    def relation(self, side: int) -> tuple[np.ndarray, np.ndarray]:
+        """The relation sampled on ``side`` (+1: T' > 0, -1: T' < 0) sorted by torque:
+        (theta, T'); raises if not monotone.
+
+        One side only: the two sides are reached on separate paths from the mount, and a
+        locked slice's states at +bias and -bias can cross by a few contact tolerances
+        (twist(-bias) > twist(+bias)), which is not a property of either side's relation.
+        Between the sides the slice sits in its backlash and carries (about) the bias."""
+        T, th = np.array(self.torque), np.array(self.twist)
+        keep = np.sign(T) == side
+        order = np.argsort(T[keep])
+        T, th = T[keep][order], th[keep][order]
+        drop = -np.diff(th).min(initial=0.0)
+        if drop > THETA_TOL:
+            raise ContactFailure(f"coning: slice k={self.push:.4f} twist not monotone in torque "
+                                 f"on the {'+' if side > 0 else '-'} side (falls by "
+                                 f"{drop / ARCMIN:.2e} arcmin)")
         return np.maximum.accumulate(th), T
 
 
@@ -132,7 +143,7 @@ def build_slice(base: LostMotionModel, geom: DriveGeometry, push: float) -> Slic
 def _combined_theta(curves: list[SliceCurve], torque: float) -> tuple[float, np.ndarray]:
     """theta with mean_j T'_j(theta) = torque on the piecewise-linear sampled relations, and
     each slice's share T'_j there."""
-    rel = [c.relation() for c in curves]
+    rel = [c.relation(1 if torque > 0 else -1) for c in curves]
     grid = np.unique(np.concatenate([th for th, _ in rel]))
     total = np.mean([np.interp(grid, th, T) for th, T in rel], axis=0)
     if not (total[0] <= torque <= total[-1]):
@@ -159,7 +170,7 @@ def coupled_twist(curves: list[SliceCurve], torque: float) -> tuple[float, int]:
     sign, worst = (1.0 if torque > 0 else -1.0), math.inf
     for rounds in range(MAX_REFINE):
         theta, shares = _combined_theta(curves, torque)
-        short = [c for c in curves if sign * (theta - c.relation()[0][-1 if sign > 0 else 0]) > 0]
+        short = [c for c in curves if sign * (theta - c.relation(int(sign))[0][-1 if sign > 0 else 0]) > 0]
         for c in short:
             c.solve(2.0 * (max(c.torque) if sign > 0 else min(c.torque)))
         if short:
