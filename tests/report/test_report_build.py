@@ -170,3 +170,20 @@ def test_ball_load_sentence_holds_the_mount_against_iso_76():
     assert "12–2200 N" in said and "890–5090 MPa" in said and "in 1 of 3 designs above the 4200 MPa" in said
     assert "within the 4200 MPa" in _ball_load(lm.iloc[:2])
     assert _ball_load(pd.DataFrame({"lost_motion_arcmin": [1.0]})) == ""
+
+
+def test_convergence_table_marks_changes_below_the_contact_tolerance():
+    """A design that misses 2 % by less than the solver resolves is marked *res.*, counted apart
+    from the converged ones and from the real misses; an older table (no resolution) says
+    nothing more."""
+    import pandas as pd
+    from hdwf.report.fe_part import _below_resolution, _convergence_rows
+    conv = pd.DataFrame({"design_id": ["a", "b", "c"], "phi_fine_arcmin": [1.0, 0.031, 0.040],
+                         "phi_medium_arcmin": [1.01, 0.030, 0.030], "rel_change_fine": [0.0099, 0.0323, 0.25],
+                         "converged": [True, False, False], "within_resolution": [True, True, False],
+                         "resolution_arcmin": [0.0067] * 3})
+    rows = _convergence_rows(conv, ("fine", "medium"))
+    assert [r[-1] for r in rows] == ["yes", "*res.*", "*no*"]
+    said = _below_resolution(conv)
+    assert said.startswith(", 1 more (*res.*)") and "0.0067 arcmin" in said
+    assert _below_resolution(conv.drop(columns=["within_resolution", "resolution_arcmin"])) == ""

@@ -69,3 +69,23 @@ def test_convergence_table_two_and_three_meshes():
     assert table.loc["a", "phi_extrapolated_arcmin"] == pytest.approx(exact, rel=1e-9)
     assert bool(table.loc["b", "converged"]) and math.isnan(table.loc["b", "gci_fine"])
     assert not bool(table.loc["c", "converged"]) and "failed" in table.loc["c", "note"]
+
+
+def test_a_change_below_the_contact_tolerance_is_flagged_not_hidden():
+    """4 tol / r_b: tol 0.01 um over r_b 20 mm is 2e-6 rad = 6.875e-3 arcmin. A design at
+    Phi 0.03 arcmin changing by 0.001 arcmin misses 2 % but lies within it; one changing by
+    0.01 arcmin does not; 'converged' keeps the 2 % criterion either way."""
+    import pandas as pd
+
+    from hdwf.study.convergence import convergence_table, twist_resolution_arcmin
+
+    res = twist_resolution_arcmin(1e-5, 20.0)
+    assert res == pytest.approx(2e-6 * 180 * 60 / math.pi, rel=1e-12)
+    assert res == pytest.approx(6.875e-3, rel=1e-3)
+    rows = [{"design_id": d, "refinement": r, "h_mm": 0.034 / r, "lost_motion_arcmin": phi}
+            for d, (p1, p2) in (("small", (0.030, 0.031)), ("moved", (0.030, 0.040)))
+            for r, phi in ((1.0, p1), (1.25, p2))]
+    table = convergence_table(pd.DataFrame(rows), res).set_index("design_id")
+    assert table.loc["small", "change_fine_arcmin"] == pytest.approx(0.001)
+    assert bool(table.loc["small", "within_resolution"]) and not bool(table.loc["small", "converged"])
+    assert not bool(table.loc["moved", "within_resolution"]) and not bool(table.loc["moved", "converged"])

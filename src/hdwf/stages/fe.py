@@ -16,9 +16,11 @@ import pandas as pd
 from hdwf import PARAMETER_COLUMNS
 from hdwf.common.io import atomic_path, read_parquet_meta, write_parquet
 from hdwf.drive.design import (MeshSettings, design_parameters, geometry_of, load_drive_mesh, save_drive_mesh)
+from hdwf.drive.geometry import nominal_geometry
 from hdwf.fe import solve_lost_motion
+from hdwf.fe.solver import TOL_GAP
 from hdwf.study.aggregate import write_lost_motion
-from hdwf.study.convergence import convergence_table
+from hdwf.study.convergence import convergence_table, twist_resolution_arcmin
 from hdwf.study.fe_design import solve_design
 from hdwf.study.paper import load_fea_designs
 from hdwf.validation.effects import model_changes
@@ -101,7 +103,8 @@ def convergence_stage(default_lost_motion, other_rows, default_refinement: float
     others = pd.concat([pd.read_parquet(p) for p in other_rows], ignore_index=True)
     cols = ["design_id", "refinement", "h_tooth_mm", "lost_motion_arcmin"]
     results = pd.concat([default[cols], others[cols]], ignore_index=True).rename(columns={"h_tooth_mm": "h_mm"})
-    table = convergence_table(results)
+    resolution = twist_resolution_arcmin(TOL_GAP, nominal_geometry(meta["unit"]).r_cs_base)
+    table = convergence_table(results, resolution)
     write_parquet(table, out, provenance=provenance, meta={**meta, "criterion": "two finest meshes differ < 2 %"})
     return table
 

@@ -72,11 +72,23 @@ def gci(h: tuple[float, float, float], phi: tuple[float, float, float], safety: 
     return GCIResult(root, ext, rel, safety * rel / (r21 ** root - 1.0), True, True, "")
 
 
-def convergence_table(results: pd.DataFrame) -> pd.DataFrame:
+def twist_resolution_arcmin(tol_gap_mm: float, base_radius_mm: float) -> float:
+    """The smallest change of Φ between two solves that the contact tolerance resolves.
+
+    A solve stops once no pair penetrates by more than ``tol_gap_mm``; a flank at base radius
+    r_b turns by gap / r_b per unit of normal gap, so each twist θ(±T) is known to
+    tol / r_b, Φ = θ(+T) − θ(−T) to 2 tol / r_b, and the difference of two Φ to 4 tol / r_b.
+    """
+    return 4.0 * tol_gap_mm / base_radius_mm * 180.0 * 60.0 / math.pi
+
+
+def convergence_table(results: pd.DataFrame, resolution_arcmin: float | None = None) -> pd.DataFrame:
     """One row per design: Φ on the fine, medium and coarse mesh, the GCI and the fine change.
 
     ``results`` has columns design_id, refinement, h_mm (representative element size),
-    lost_motion_arcmin.
+    lost_motion_arcmin.  With ``resolution_arcmin`` (``twist_resolution_arcmin``) each row also
+    says whether the two finest meshes differ by no more than the solver resolves
+    (``within_resolution``): a relative criterion cannot be met below that, at small Φ.
     """
     out = []
     levels = ("fine", "medium", "coarse")
@@ -91,7 +103,11 @@ def convergence_table(results: pd.DataFrame) -> pd.DataFrame:
             row.update({"converged": False, "note": "a refinement failed or is missing"})
         else:
             row["rel_change_fine"] = float(abs(phi[1] - phi[0]) / abs(phi[0]))
+            row["change_fine_arcmin"] = float(abs(phi[1] - phi[0]))
             row["converged"] = bool(row["rel_change_fine"] < 0.02)
+            if resolution_arcmin is not None:
+                row["resolution_arcmin"] = float(resolution_arcmin)
+                row["within_resolution"] = bool(row["change_fine_arcmin"] <= resolution_arcmin)
             row["note"] = ""
             if len(sub) == 3:
                 g = gci(tuple(sub["h_mm"]), tuple(phi))
