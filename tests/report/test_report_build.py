@@ -187,3 +187,18 @@ def test_convergence_table_marks_changes_below_the_contact_tolerance():
     said = _below_resolution(conv)
     assert said.startswith(", 1 more (*res.*)") and "0.0067 arcmin" in said
     assert _below_resolution(conv.drop(columns=["within_resolution", "resolution_arcmin"])) == ""
+
+
+def test_ladder_is_held_against_the_bearing_rating():
+    """The ladder section says which rung's balls exceed ISO 76's 4200 MPa and what that means;
+    a rung within it, and a ladder from before the check, say so or nothing."""
+    import pandas as pd
+    from hdwf.report.validation_part import _bearing_sentence
+    lad = pd.DataFrame({"rung": [0, 1], "model": ["baseline", "with preload"],
+                        "ball_pressure_max_MPa": [950.0, 5000.0], "specimens_above_iso76": [0, 7],
+                        "specimens_checked": [27, 27]})
+    said = _bearing_sentence(lad)
+    assert "baseline 950 MPa" in said and "with preload 5000 MPa (*7 of 27 specimens above*)" in said
+    assert "from rung 1 on" in said and "dent" in said
+    assert "Every rung stays within it" in _bearing_sentence(lad.iloc[:1])
+    assert _bearing_sentence(lad.drop(columns=["specimens_checked"])) == ""

@@ -227,6 +227,23 @@ def _round_verdict(rnd: dict) -> str:
     return txt
 
 
+def _bearing_sentence(ladder: pd.DataFrame) -> str:
+    """The rungs held against the wave-generator bearing's static rating (ISO 76, 4200 MPa)."""
+    if "specimens_checked" not in ladder or not ladder["specimens_checked"].gt(0).any():
+        return ""
+    parts = [f"{lit(r['model'])} {fmt(r['ball_pressure_max_MPa'], 0)} MPa"
+             + (f" (*{r['specimens_above_iso76']} of {r['specimens_checked']} specimens above*)"
+                if r["specimens_above_iso76"] else "")
+             for r in ladder.to_dict("records") if r["specimens_checked"] > 0]
+    over = ladder[ladder["specimens_above_iso76"] > 0]
+    verdict = (f" A model whose balls exceed the rating is not one a real drive of these dimensions could be "
+               f"assembled to (its raceways would dent): from rung {int(over['rung'].iloc[0])} on, the found "
+               "effect stands in for something the model lacks rather than being it."
+               if len(over) else " Every rung stays within it.")
+    return ("Is the model physically admissible? The most loaded wave-generator ball at the mount, against the "
+            "4200 MPa static rating of ISO 76, rung by rung: " + "; ".join(parts) + "." + verdict)
+
+
 def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2) -> None:
     """One campaign: where the model fails, which effect is missing, what the data could show, the ladder.
 
@@ -259,6 +276,9 @@ def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2)
               "Each rung re-solved with the FE model (not interpolated): the found effects switched on at their "
               "calibrated values. ΔBIC against the first rung."
               + (f" Stated noise: {fmt(noise, 4)} arcmin." if noise else ""))
+    bearing = _bearing_sentence(ladder)
+    if bearing:
+        doc.text(bearing)
     doc.figure(campaign.ladder_png, "The error falling rung by rung.", width="75%")
     for name, note in diag.get("notes", {}).items():
         doc.text(f"Note on {lit(name)}: {lit(note)}.")

@@ -12,6 +12,7 @@ import json
 import numpy as np
 import pandas as pd
 
+from hdwf.fe.hertz import ISO76_BALL_PRESSURE_MPA
 from hdwf.validation.comparison import bic
 from hdwf.validation.measurements import Measurements
 from hdwf.validation.observations import observation_frame, predict
@@ -60,7 +61,9 @@ def ladder_table(meas: Measurements, table: pd.DataFrame, rungs: list[tuple[str,
     -------
     pandas.DataFrame
         ``rung``, ``model``, ``effects`` (JSON), ``n_params``, ``rmse_arcmin``, ``bias_arcmin``,
-        ``max_abs_arcmin``, ``delta_bic`` (against the first rung) and ``solved``.
+        ``max_abs_arcmin``, ``delta_bic`` (against the first rung), ``solved``, and the bearing
+        check of the rung's model (``bearing_check``): the largest ball pressure at the mount over
+        the specimens and how many exceed ISO 76's static rating.
     """
     obs = observation_frame(meas)
     D = obs["D"].to_numpy(float)
@@ -74,8 +77,27 @@ def ladder_table(meas: Measurements, table: pd.DataFrame, rungs: list[tuple[str,
         rows.append({"rung": k, "model": label, "effects": json.dumps(eff, sort_keys=True),
                      "n_params": n_par, "rmse_arcmin": float(np.sqrt(rss / len(D))),
                      "bias_arcmin": float(np.nanmean(S - D)), "max_abs_arcmin": float(np.nanmax(np.abs(S - D))),
-                     "delta_bic": float(b - b0), "solved": bool(np.isfinite(S).all())})
+                     "delta_bic": float(b - b0), "solved": bool(np.isfinite(S).all()),
+                     **bearing_check(table, variant_key(eff))})
     return pd.DataFrame(rows)
+
+
+def bearing_check(table: pd.DataFrame, key: str) -> dict:
+    """The wave-generator bearing under variant ``key``: is a found effect physically admissible?
+
+    An effect calibrated to the data may ask for more than the drive can take: a tooth
+    interference that presses the wave generator's balls into their raceways beyond the
+    static rating (ISO 76: 4200 MPa at the most loaded contact), where a real bearing would
+    dent at assembly. Returns ``ball_pressure_max_MPa`` (the largest over the specimens),
+    ``specimens_above_iso76`` and ``specimens_checked`` (specimens with a solved pressure);
+    NaN / 0 for tables made before the column existed.
+    """
+    if "ball_pressure_max_MPa" not in table:
+        return {"ball_pressure_max_MPa": np.nan, "specimens_above_iso76": 0, "specimens_checked": 0}
+    per = table[table["variant"] == key].groupby("specimen_id")["ball_pressure_max_MPa"].max().dropna()
+    return {"ball_pressure_max_MPa": float(per.max()) if len(per) else np.nan,
+            "specimens_above_iso76": int((per > ISO76_BALL_PRESSURE_MPA).sum()),
+            "specimens_checked": int(len(per))}
 
 
 def solve_ladder(meas: Measurements, table: pd.DataFrame, rungs: list[tuple[str, dict]],

@@ -174,7 +174,7 @@ def synth_curves(setup: SolveSetup, n_designs: int, seed: int,
     if len(bad):
         raise RuntimeError(f"synthesis: the FE solve failed for specimen "
                            f"{bad['specimen_id'].iloc[0]}: {bad['status'].iloc[0]}")
-    return specimens.merge(table.drop(columns=["variant", "status"]), on="specimen_id")
+    return specimens.merge(table[["specimen_id", "step", "torque_Nm", "twist_arcmin"]], on="specimen_id")
 
 
 def add_noise(curves: pd.DataFrame, noise_arcmin: float, seed: int) -> pd.DataFrame:

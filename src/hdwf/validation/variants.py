@@ -44,7 +44,9 @@ from hdwf.validation.effects import get as get_effect
 from hdwf.validation.effects import model_changes, registry
 
 BASELINE = "baseline"
-TABLE_COLUMNS = ["specimen_id", "variant", "step", "torque_Nm", "twist_arcmin", "status"]
+TABLE_COLUMNS = ["specimen_id", "variant", "step", "torque_Nm", "twist_arcmin", "status", "ball_pressure_max_MPa"]
+# ball_pressure_max_MPa: the most loaded wave-generator ball's raceway pressure at the mount (the
+# same for every step of a variant), to hold a found effect against the bearing's rating
 # the thread counts of the BLAS libraries numpy and scipy may be linked against
 _BLAS_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
@@ -196,7 +198,8 @@ def solve_specimen(setup: SolveSetup, specimen: Mapping, variants: list[dict]) -
             "specimen_id": specimen["specimen_id"], "variant": variant_key(eff),
             "step": np.asarray(step, dtype="int64"), "torque_Nm": np.asarray(torque, float),
             "twist_arcmin": np.asarray(tw, float),
-            "status": "ok" if ok else f"failed: {res.reason}"}))
+            "status": "ok" if ok else f"failed: {res.reason}",
+            "ball_pressure_max_MPa": float(res.max_ball_pressure_MPa) if ok else np.nan}))
     return pd.concat(frames, ignore_index=True)[TABLE_COLUMNS]
 
 

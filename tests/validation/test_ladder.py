@@ -1,0 +1,60 @@
+"""The error ladder (``hdwf.validation.ladder``) on hand-made tables: its rungs, their errors and
+the bearing check that says whether a found effect is one a real drive could have."""
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hdwf.fe.hertz import ISO76_BALL_PRESSURE_MPA
+from hdwf.validation.ladder import bearing_check, ladder_table, ladder_variants
+from hdwf.validation.measurements import Measurements
+from hdwf.validation.variants import TABLE_COLUMNS, variant_key
+
+PRELOAD = {"preload": {"interference_m": 0.2}}
+
+
+def _rows(sid, effects, lost_motion, pressure):
+    """One variant's test 0 -> +T -> 0 -> -T -> 0 whose lost motion is ``lost_motion``."""
+    tw = np.array([0.0, 0.5, 0.1, 0.5 - lost_motion, 0.0])
+    return pd.DataFrame({"specimen_id": sid, "variant": variant_key(effects), "step": np.arange(5),
+                         "torque_Nm": [0.0, 0.96, 0.0, -0.96, 0.0], "twist_arcmin": tw, "status": "ok",
+                         "ball_pressure_max_MPa": pressure})[TABLE_COLUMNS]
+
+
+def _campaign():
+    meas = pd.DataFrame({"specimen_id": ["s1", "s2"], "lost_motion_arcmin": [1.0, 2.0]})
+    m = Measurements(Path("lm.csv"), "lost_motion", meas, meas.assign(unit="hd42"))
+    table = pd.concat([_rows("s1", {}, 3.0, 900.0), _rows("s2", {}, 4.0, 950.0),
+                       _rows("s1", PRELOAD, 1.1, 3000.0), _rows("s2", PRELOAD, 1.9, 5000.0)],
+                      ignore_index=True)
+    return m, table
+
+
+def test_rungs_switch_the_found_effects_on_in_order():
+    rungs = ladder_variants({}, [("preload", {"interference_m": 0.2}), ("fs_cup_torsion", {"K_Nm_per_rad": 2e5})])
+    assert [label for label, _ in rungs] == ["baseline", "with preload", "with preload, fs_cup_torsion"]
+    assert rungs[2][1] == {"preload": {"interference_m": 0.2}, "fs_cup_torsion": {"K_Nm_per_rad": 2e5}}
+
+
+def test_ladder_gives_each_rungs_error_and_holds_it_against_the_bearing():
+    """Errors 2 and 2 arcmin on the bare rung (RMSE 2), +0.1 and -0.1 with the preload (RMSE 0.1);
+    the preloaded balls reach 3000 and 5000 MPa: one of two specimens above ISO 76's 4200 MPa."""
+    meas, table = _campaign()
+    lad = ladder_table(meas, table, ladder_variants({}, [("preload", {"interference_m": 0.2})]))
+    assert lad["rmse_arcmin"].tolist() == pytest.approx([2.0, 0.1])
+    assert lad["bias_arcmin"].tolist() == pytest.approx([2.0, 0.0], abs=1e-12)
+    assert lad["ball_pressure_max_MPa"].tolist() == [950.0, 5000.0]
+    assert lad["specimens_above_iso76"].tolist() == [0, 1]
+    assert lad["specimens_checked"].tolist() == [2, 2]
+    assert ISO76_BALL_PRESSURE_MPA == 4200
+
+
+def test_a_table_without_pressures_checks_nothing():
+    """Tables written before the column existed: no number is made up."""
+    _, table = _campaign()
+    got = bearing_check(table.drop(columns="ball_pressure_max_MPa"), variant_key(PRELOAD))
+    assert np.isnan(got["ball_pressure_max_MPa"]) and got["specimens_checked"] == 0
+    failed = table.assign(ball_pressure_max_MPa=np.where(table["specimen_id"] == "s2", np.nan, 3000.0))
+    assert bearing_check(failed, variant_key(PRELOAD))["specimens_checked"] == 1
