@@ -7,6 +7,7 @@ from __future__ import annotations
 import pandas as pd
 
 from hdwf.common.io import read_json
+from hdwf.fe.hertz import ISO76_BALL_PRESSURE_MPA
 from hdwf.report.artefacts import CampaignArtefacts
 from hdwf.report.document import UNIT_NAMES, Document, fmt, lit
 from hdwf.validation.effects import get as get_effect
@@ -241,7 +242,7 @@ def _bearing_sentence(ladder: pd.DataFrame) -> str:
                "effect stands in for something the model lacks rather than being it."
                if len(over) else " Every rung stays within it.")
     return ("Is the model physically admissible? The most loaded wave-generator ball at the mount, against the "
-            "4200 MPa static rating of ISO 76, rung by rung: " + "; ".join(parts) + "." + verdict)
+            f"{ISO76_BALL_PRESSURE_MPA:g} MPa static rating of ISO 76, rung by rung: " + "; ".join(parts) + "." + verdict)
 
 
 def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2) -> None:
