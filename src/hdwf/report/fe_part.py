@@ -15,6 +15,7 @@ from hdwf import PARAMETERS
 from hdwf.common.io import read_json
 from hdwf.fe.cycle import EXIT_ARC_DEG
 from hdwf.fe.hertz import ISO76_BALL_PRESSURE_MPA
+from hdwf.fe.solver import TOL_GAP
 from hdwf.report.artefacts import FeSettings, ReportInputs, StudyArtefacts
 from hdwf.report.document import UNIT_NAMES, Document, fmt, lit, math_label
 from hdwf.report.figures import agreement_figure, curves_figure, knee_figure
@@ -81,12 +82,15 @@ def _convergence_rows(conv: pd.DataFrame, levels: tuple[str, ...]) -> list[list[
     return rows
 
 
+BELOW_RESOLUTION = "*res.*"   # the mark of a miss of 2 % within what the contact tolerance resolves
+
+
 def _verdict(r: dict) -> str:
     """'yes' within 2 %; otherwise *no*, or *res.* when the change is below what the contact
     tolerance resolves (Φ small: 2 % of it is less than the solver can tell apart)."""
     if r["converged"]:
         return "yes"
-    return "*res.*" if r.get("within_resolution") is True else "*no*"
+    return BELOW_RESOLUTION if r.get("within_resolution") is True else "*no*"
 
 
 def convergence_section(doc: Document, study: StudyArtefacts, level: int = 1) -> None:
@@ -126,8 +130,9 @@ def _below_resolution(conv: pd.DataFrame) -> str:
     if "within_resolution" not in conv:
         return ""
     n = int((~conv["converged"].astype(bool) & conv["within_resolution"].eq(True)).sum())
-    return (f", {n} more (*res.*) change by no more than the contact tolerance resolves "
-            f"({fmt(conv['resolution_arcmin'].iloc[0], 4)} arcmin: 4 × 0.01 µm over the base radius), where 2 % of "
+    return (f", {n} more ({BELOW_RESOLUTION}) change by no more than the contact tolerance resolves "
+            f"({fmt(conv['resolution_arcmin'].iloc[0], 4)} arcmin: 4 × {TOL_GAP * 1000:g} µm over the base radius), "
+            "where 2 % of "
             "their small $Phi$ is below it") if n else ""
 
 
