@@ -1,10 +1,12 @@
 """One design's lost motion on ever finer meshes, with the FE studies' effects: is Φ converged?
 
 Meshes the design of ``--designs`` (a study's ``designs.parquet``, e.g. the default target's
-``results/fe/hd42/designs.parquet``) at each ``--refinements`` factor of the default 10 x 6
-elements per tooth (half model, 5 steps per ramp), solves it with ``--effects`` switched on
-(default: the ``fe.effects`` of ``config.yaml``) and appends one row per mesh to ``--out``
-(CSV: design, refinement, nodes, status, Φ, φ+, φ−, teeth in contact, seconds).
+``results/fe/hd42/designs.parquet``) at each ``--refinements`` factor of ``--mesh`` elements
+over the tooth height x thickness (default 10x6, the studies'; half model, 5 steps per ramp),
+solves it with ``--effects`` switched on (default: the ``fe.effects`` of ``config.yaml``) and
+appends one row per mesh to ``--out`` (CSV: design, mesh, refinement, nodes, status, Φ, φ+, φ−,
+teeth in contact, seconds).  ``--mesh 20x6`` refines the teeth only (their size is set by
+the finer of height / 20 and thickness / 6), not the rims.
 
 Run with one thread, e.g.
   python benchmarks/bench_mesh_refinement.py --unit hd42 --designs results/fe/hd42/designs.parquet \\
@@ -31,20 +33,21 @@ from hdwf.validation.effects import model_changes
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def refine(unit: str, designs: Path, design: str, refinements: list[float], effects: dict, out: Path) -> None:
+def refine(unit: str, designs: Path, design: str, refinements: list[float], effects: dict, out: Path,
+           per_tooth: tuple[int, int] = (10, 6)) -> None:
     params = design_parameters(designs, design)
     changes = model_changes(effects)
     geom = geometry_of(unit, params, **changes.geometry_part())
     for ref in refinements:
         t0 = time.perf_counter()
-        mesh = build_mesh(geom, 10, 6, ref, symmetry="half")
+        mesh = build_mesh(geom, *per_tooth, ref, symmetry="half")
         res = solve_lost_motion(geom, mesh, steps_per_ramp=5, changes=changes)
-        rec = {"design": design, "refinement": ref, "effects": json.dumps(effects),
+        rec = {"design": design, "mesh": "x".join(map(str, per_tooth)), "refinement": ref, "effects": json.dumps(effects),
                "nodes": sum(b.mesh.p.shape[1] for b in mesh.bodies.values()), "status": res.status,
                "phi": res.lost_motion_arcmin, "phi_plus": res.phi_plus_arcmin, "phi_minus": res.phi_minus_arcmin,
                "teeth": res.teeth_in_contact, "seconds": time.perf_counter() - t0}
         pd.DataFrame([rec]).to_csv(out, mode="a", header=not out.exists(), index=False)
-        print(f"{design} refinement {ref:g}: {res.status} Φ {res.lost_motion_arcmin:.4f} arcmin "
+        print(f"{design} mesh {rec['mesh']} refinement {ref:g}: {res.status} Φ {res.lost_motion_arcmin:.4f} arcmin "
               f"(φ+ {res.phi_plus_arcmin:.4f}, φ− {res.phi_minus_arcmin:.4f}), {rec['teeth']} teeth, "
               f"{rec['nodes']} nodes, {rec['seconds']:.1f} s", flush=True)
 
@@ -57,7 +60,9 @@ if __name__ == "__main__":
     ap.add_argument("--refinements", default="0.75,1,1.25,1.5,2")
     ap.add_argument("--effects", default=None, help='JSON {name: {param: value}}; default: config.yaml fe.effects')
     ap.add_argument("--out", type=Path, default=Path("refine.csv"))
+    ap.add_argument("--mesh", default="10x6", help="elements over the tooth height x thickness")
     a = ap.parse_args()
     effects = json.loads(a.effects) if a.effects else \
         yaml.safe_load((ROOT / "config.yaml").read_text())["fe"].get("effects", {})
-    refine(a.unit, a.designs, a.design, [float(x) for x in a.refinements.split(",")], effects, a.out)
+    per_tooth = tuple(int(n) for n in a.mesh.split("x"))
+    refine(a.unit, a.designs, a.design, [float(x) for x in a.refinements.split(",")], effects, a.out, per_tooth)

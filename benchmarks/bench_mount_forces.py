@@ -8,12 +8,15 @@ whole drive), the most loaded ball and its raceway pressure against ISO 76's 420
 tangential force the test torque puts on the mesh, T / r_p. ``--bands`` adds the tooth normal
 force at the mount and at +T per 10° band from the nearer major axis, split into pairs whose
 slave node is an FS flank node and CS tip nodes (the second pass, a CS tip on an FS flank),
-over one half of the half model.
+over one half of the half model. ``--depth`` adds how deep in the CS spaces the loaded pairs
+sit at +T: force and pair count per 0.1 m band of the slave node's deformed radius minus the CS
+tip radius (0: on the CS tip's edge; the CS root is about 1.9 m deeper).
 It hooks ``hdwf.fe.cycle``'s mount and ±T settling while it runs to read their contact states.
 
 Example (docs/fe-model.md, "The studies' model"):
   OMP_NUM_THREADS=1 python benchmarks/bench_mount_forces.py --unit hd42 \\
       --designs results/fe/hd42/designs.parquet --design hd42-lhs-23 --preload 0,0.05,0.1,0.157 --bands
+  ... --design hd42-lhs-23 --preload 0.157 --depth --out depth.csv
 """
 
 from __future__ import annotations
@@ -85,6 +88,24 @@ def tooth_bands(model, level) -> pd.DataFrame:
     return df
 
 
+def contact_depth_bands(model, level) -> pd.Series:
+    """Force (N) of the loaded tooth pairs of the +T state per 0.1 m band of how deep their slave
+    node sits in the CS space: its deformed radius minus the CS tip radius (0 at the CS tip edge,
+    about 1.9 m at the CS root), FS flank nodes and CS tip nodes (second pass) apart."""
+    g = model.geometry
+    u = model.full_displacements(level, g.torque)
+    fs_nodes, cs_nodes = model.rows["tooth"].slave_nodes
+    where, force = [], []
+    for (kind, i), p in zip(level.pair_ids, level.normal_force):
+        if kind != "tooth" or p <= 0:
+            continue
+        body, node, side = ("fs", fs_nodes[i], "FS node") if i < fs_nodes.size else ("cs", cs_nodes[i - fs_nodes.size], "CS tip node")
+        r = math.hypot(*(model.bodies[body].x[:, node] + u[body][:, node]))
+        where.append(f"{side} {math.floor((r - g.r_cs_tip) / g.module * 10) / 10:+.1f} m")
+        force.append(p)
+    return pd.Series(force, index=where, name="force_N").groupby(level=0).agg(["sum", "count"])
+
+
 def _iso_load(geom) -> float:
     """The ball load that gives ISO 76's pressure."""
     return brentq(lambda P: ball_max_pressure(geom, P) - ISO76_BALL_PRESSURE_MPA, 1.0, 1e7)
@@ -99,6 +120,10 @@ if __name__ == "__main__":
     ap.add_argument("--preload", default="0,0.157", help="interference_m values (0: the bare section)")
     ap.add_argument("--refinement", type=float, default=1.0)
     ap.add_argument("--bands", action="store_true", help="tooth forces per 10° band at the mount and at +T")
+    ap.add_argument("--depth", action="store_true",
+                    help="tooth forces at +T by how deep in the CS spaces they sit")
+    ap.add_argument("--out", type=Path, help="with --depth: append design, preload, Φ and the share "
+                                             "of the tooth force on the CS tips' edges to this CSV")
     a = ap.parse_args()
     if a.designs is not None:
         params = design_parameters(a.designs, a.design)
@@ -121,4 +146,16 @@ if __name__ == "__main__":
             at_mount = tooth_bands(*states["mount"]).groupby(["band", "slave"], observed=True)["force_N"].sum()
             at_plus = tooth_bands(*states["+T"]).groupby(["band", "slave"], observed=True)["force_N"].sum()
             print(pd.DataFrame({"mount_N": at_mount, "plus_T_N": at_plus}).round(1).to_string(), flush=True)
+        if a.depth and "+T" in states:
+            bands = contact_depth_bands(*states["+T"])
+            edge = bands["sum"][[k.startswith("CS") or k.endswith(" +0.0 m") or " -" in k
+                                 for k in bands.index]].sum() / bands["sum"].sum()
+            print(f"  at +T by depth in the CS space (m {geom.module:.4f} mm): {edge:.0%} of the tooth force "
+                  "within 0.1 m of the CS tips' edges\n" + bands.round(1).to_string(), flush=True)
+            if a.out is not None:
+                rec = {"unit": a.unit, "design": a.design or a.base or "nominal", "interference_m": delta,
+                       "refinement": a.refinement, "status": res.status, "phi": res.lost_motion_arcmin,
+                       "tooth_force_plus_T_N": float(bands["sum"].sum()), "loaded_pairs": int(bands["count"].sum()),
+                       "cs_tip_edge_share": float(edge)}
+                pd.DataFrame([rec]).to_csv(a.out, mode="a", header=not a.out.exists(), index=False)
 
