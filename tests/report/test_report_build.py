@@ -191,18 +191,18 @@ def test_convergence_table_marks_changes_below_the_contact_tolerance():
 
 def test_convergence_caption_says_where_the_misses_are():
     """The real misses (beyond the resolution) are compared with the converged designs by their
-    median Phi, and read as the preloaded small-Phi designs only when they are the smaller."""
+    median Phi, with the pointer to a locked design's diagnosis only when theirs is the smaller."""
     import pandas as pd
     from hdwf.report.fe_part import _where_it_misses
     conv = pd.DataFrame({"phi_fine_arcmin": [2.0, 4.0, 0.03, 0.1, 0.3],
                          "converged": [True, True, False, False, False],
                          "within_resolution": [False, False, True, False, False]})
     said = _where_it_misses(conv)
-    assert "the 2 that miss by more have median $Phi$ 0.200 arcmin (largest 0.300), the converged ones 3.000" in said
-    assert "preload holds the teeth" in said
+    assert "the 2 that miss by more have median $Phi$ 0.200 arcmin (largest 0.300), the converged ones 3.000 arcmin" in said
+    assert "the misses are at the smaller $Phi$" in said and "locked" in said
     conv["phi_fine_arcmin"] = [0.1, 0.2, 0.03, 2.0, 4.0]     # misses at large Phi: no such reading
     said = _where_it_misses(conv)
-    assert "median $Phi$ 3.000 arcmin" in said and "preload" not in said
+    assert "median $Phi$ 3.000 arcmin" in said and "locked" not in said
     assert _where_it_misses(conv.assign(converged=True)) == ""
 
 

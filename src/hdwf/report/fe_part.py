@@ -137,7 +137,8 @@ def _below_resolution(conv: pd.DataFrame) -> str:
 
 
 def _where_it_misses(conv: pd.DataFrame) -> str:
-    """Whether the designs that miss by more than the resolution are the ones of small Phi."""
+    """The median Phi of the designs that miss by more than the resolution against the converged
+    ones', and the docs' diagnosis of a locked design's Phi only when theirs is the smaller."""
     within = conv["within_resolution"].eq(True) if "within_resolution" in conv else False
     converged = conv["converged"].astype(bool)
     miss = conv.loc[~converged & ~within, "phi_fine_arcmin"].dropna()
@@ -145,10 +146,10 @@ def _where_it_misses(conv: pd.DataFrame) -> str:
     if miss.empty or ok.empty:
         return ""
     said = (f"; the {len(miss)} that miss by more have median $Phi$ {fmt(miss.median(), 3)} arcmin (largest "
-            f"{fmt(miss.max(), 3)}), the converged ones {fmt(ok.median(), 3)}")
+            f"{fmt(miss.max(), 3)}), the converged ones {fmt(ok.median(), 3)} arcmin")
     if miss.median() < ok.median():
-        said += (": the misses are at the small $Phi$ where the preload holds the teeth, and docs/fe-model.md "
-                 "(Mesh convergence) traces such a $Phi$ to preloaded flank contacts carried by one or two nodes each")
+        said += (": the misses are at the smaller $Phi$, and docs/fe-model.md (Mesh convergence) traces a locked "
+                 "design's $Phi$ to preloaded flank contacts carried by one or two nodes each")
     return said
 
 
