@@ -5,8 +5,9 @@ Meshes the design of ``--designs`` (a study's ``designs.parquet``, e.g. the defa
 over the tooth height x thickness (default 10x6, the studies'; half model, 5 steps per ramp),
 solves it with ``--effects`` switched on (default: the ``fe.effects`` of ``config.yaml``) and
 appends one row per mesh to ``--out`` (CSV: design, mesh, refinement, nodes, status, Φ, φ+, φ−,
-teeth in contact, seconds).  ``--mesh 20x6`` refines the teeth only (their size is set by
-the finer of height / 20 and thickness / 6), not the rims.
+teeth in contact, seconds).  ``--mesh 20x6`` refines the teeth (their size is the finer
+of height / 20 and thickness / 6) and what grades from them (the FS rim, the CS rim where four
+tooth sizes decide), not the bearing rings.
 
 Run with one thread, e.g.
   python benchmarks/bench_mesh_refinement.py --unit hd42 --designs results/fe/hd42/designs.parquet \\

@@ -9,8 +9,8 @@ tangential force the test torque puts on the mesh, T / r_p. ``--bands`` adds the
 force at the mount and at +T per 10° band from the nearer major axis, split into pairs whose
 slave node is an FS flank node and CS tip nodes (the second pass, a CS tip on an FS flank),
 over one half of the half model. ``--depth`` adds how deep in the CS spaces the loaded pairs
-sit at +T: force and pair count per 0.1 m band of the slave node's deformed radius minus the CS
-tip radius (0: on the CS tip's edge; the CS root is about 1.9 m deeper).
+sit at +T: force and pair count per 0.1 m band (``band_m``) of the slave node's deformed radius
+minus the CS tip radius (0: on the CS tip's edge; the CS root is about 1.9 m deeper).
 It hooks ``hdwf.fe.cycle``'s mount and ±T settling while it runs to read their contact states.
 
 Example (docs/fe-model.md, "The studies' model"):
@@ -71,39 +71,40 @@ def kind_sums(level) -> dict[str, float]:
     return {k: float(level.normal_force[kinds == k].sum()) for k in np.unique(kinds)}
 
 
+def loaded_tooth_pairs(model, level):
+    """The loaded tooth pairs of a state: (body name, slave node, slave side, normal force)."""
+    fs_nodes, cs_nodes = model.rows["tooth"].slave_nodes
+    for (kind, i), p in zip(level.pair_ids, level.normal_force):
+        if kind == "tooth" and p > 0:
+            if i < fs_nodes.size:
+                yield "fs", fs_nodes[i], "FS flank", p
+            else:
+                yield "cs", cs_nodes[i - fs_nodes.size], "CS tip", p
+
+
 def tooth_bands(model, level) -> pd.DataFrame:
     """Loaded tooth pairs of a state: angle from the nearer major axis, slave side, force."""
-    rows = model.rows["tooth"]
-    fs_nodes, cs_nodes = rows.slave_nodes
-    fs, cs = model.bodies["fs"], model.bodies["cs"]
     out = []
-    for (kind, i), p in zip(level.pair_ids, level.normal_force):
-        if kind != "tooth" or p <= 0:
-            continue
-        body, node, side = (fs, fs_nodes[i], "FS flank") if i < fs_nodes.size else (cs, cs_nodes[i - fs_nodes.size], "CS tip")
-        angle = math.degrees(math.atan2(body.x[1, node], body.x[0, node])) % 180.0
+    for body, node, side, p in loaded_tooth_pairs(model, level):
+        x = model.bodies[body].x[:, node]
+        angle = math.degrees(math.atan2(x[1], x[0])) % 180.0
         out.append((min(angle, 180.0 - angle), side, p))
     df = pd.DataFrame(out, columns=["angle_deg", "slave", "force_N"])
     df["band"] = pd.cut(df["angle_deg"], np.arange(0, 100, 10))
     return df
 
 
-def contact_depth_bands(model, level) -> pd.Series:
-    """Force (N) of the loaded tooth pairs of the +T state per 0.1 m band of how deep their slave
-    node sits in the CS space: its deformed radius minus the CS tip radius (0 at the CS tip edge,
-    about 1.9 m at the CS root), FS flank nodes and CS tip nodes (second pass) apart."""
+def contact_depths(model, level) -> pd.DataFrame:
+    """The loaded tooth pairs of the +T state with how deep their slave node sits in the CS space:
+    its deformed radius minus the CS tip radius, in modules (0 at the CS tip edge, about 1.9 at
+    the CS root), FS flank nodes and CS tip nodes (second pass) apart."""
     g = model.geometry
     u = model.full_displacements(level, g.torque)
-    fs_nodes, cs_nodes = model.rows["tooth"].slave_nodes
-    where, force = [], []
-    for (kind, i), p in zip(level.pair_ids, level.normal_force):
-        if kind != "tooth" or p <= 0:
-            continue
-        body, node, side = ("fs", fs_nodes[i], "FS node") if i < fs_nodes.size else ("cs", cs_nodes[i - fs_nodes.size], "CS tip node")
-        r = math.hypot(*(model.bodies[body].x[:, node] + u[body][:, node]))
-        where.append(f"{side} {math.floor((r - g.r_cs_tip) / g.module * 10) / 10:+.1f} m")
-        force.append(p)
-    return pd.Series(force, index=where, name="force_N").groupby(level=0).agg(["sum", "count"])
+    out = [(side, math.hypot(*(model.bodies[body].x[:, node] + u[body][:, node])) - g.r_cs_tip, p)
+           for body, node, side, p in loaded_tooth_pairs(model, level)]
+    df = pd.DataFrame(out, columns=["slave", "depth_mm", "force_N"])
+    df["depth_m"] = df["depth_mm"] / g.module
+    return df
 
 
 def _iso_load(geom) -> float:
@@ -147,9 +148,11 @@ if __name__ == "__main__":
             at_plus = tooth_bands(*states["+T"]).groupby(["band", "slave"], observed=True)["force_N"].sum()
             print(pd.DataFrame({"mount_N": at_mount, "plus_T_N": at_plus}).round(1).to_string(), flush=True)
         if a.depth and "+T" in states:
-            bands = contact_depth_bands(*states["+T"])
-            edge = bands["sum"][[k.startswith("CS") or k.endswith(" +0.0 m") or " -" in k
-                                 for k in bands.index]].sum() / bands["sum"].sum()
+            depths = contact_depths(*states["+T"])
+            band = np.floor(depths["depth_m"] * 10) / 10
+            bands = depths.groupby([depths["slave"], band.rename("band_m")])["force_N"].agg(["sum", "count"])
+            at_edge = (depths["slave"] == "CS tip") | (depths["depth_m"] < 0.1)
+            edge = depths.loc[at_edge, "force_N"].sum() / depths["force_N"].sum()
             print(f"  at +T by depth in the CS space (m {geom.module:.4f} mm): {edge:.0%} of the tooth force "
                   "within 0.1 m of the CS tips' edges\n" + bands.round(1).to_string(), flush=True)
             if a.out is not None:

@@ -125,11 +125,19 @@ def convergence_section(doc: Document, study: StudyArtefacts, level: int = 1) ->
                   "factor 3 and first order.")
 
 
+def _within_resolution(conv: pd.DataFrame) -> pd.Series:
+    """Per design: does Phi change by no more than the contact tolerance resolves (False on tables
+    from before the resolution was recorded)."""
+    if "within_resolution" not in conv:
+        return pd.Series(False, index=conv.index)
+    return conv["within_resolution"].eq(True)
+
+
 def _below_resolution(conv: pd.DataFrame) -> str:
     """The designs that miss 2 % by less than the solver resolves, said as such."""
     if "within_resolution" not in conv:
         return ""
-    n = int((~conv["converged"].astype(bool) & conv["within_resolution"].eq(True)).sum())
+    n = int((~conv["converged"].astype(bool) & _within_resolution(conv)).sum())
     return (f", {n} more ({BELOW_RESOLUTION}) change by no more than the contact tolerance resolves "
             f"({fmt(conv['resolution_arcmin'].iloc[0], 4)} arcmin: 4 × {TOL_GAP * 1000:g} µm over the base radius), "
             "where 2 % of "
@@ -139,9 +147,8 @@ def _below_resolution(conv: pd.DataFrame) -> str:
 def _where_it_misses(conv: pd.DataFrame) -> str:
     """The median Phi of the designs that miss by more than the resolution against the converged
     ones', and the docs' diagnosis of a locked design's Phi only when theirs is the smaller."""
-    within = conv["within_resolution"].eq(True) if "within_resolution" in conv else False
     converged = conv["converged"].astype(bool)
-    miss = conv.loc[~converged & ~within, "phi_fine_arcmin"].dropna()
+    miss = conv.loc[~converged & ~_within_resolution(conv), "phi_fine_arcmin"].dropna()
     ok = conv.loc[converged, "phi_fine_arcmin"].dropna()
     if miss.empty or ok.empty:
         return ""
