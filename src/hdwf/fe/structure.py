@@ -24,6 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from hdwf.fe.bodies import Body
+from hdwf.fe.node_columns import SPLIT_BODIES, NodeColumns
 
 ModeName = tuple[str, str]      # (body, mode), e.g. ("fs", "rot")
 
@@ -88,6 +89,7 @@ class Structure:
         self.half = half
         self.f_scale = 0.5 if half else 1.0
         self.nwatch = _number_watch_dofs(bodies)
+        self._node_cache: dict[str, NodeColumns] = {}    # shared by copies with the same body
         self.n_dofs = sum(b.stiffness.shape[0] for b in bodies.values())
         fs = bodies["fs"]
         # load per unit torque is f_scale * twist_measure (N/(N mm))
@@ -100,6 +102,9 @@ class Structure:
         """A copy with body ``name`` replaced (same watch numbering, same torque load)."""
         new = copy.copy(self)
         new.bodies = {**self.bodies, name: body}
+        # a body with the same factorisation (only scaled) has the same node responses
+        new._node_cache = {n: c for n, c in self._node_cache.items()
+                           if n != name or body.factor is self.bodies[name].factor}
         return new
 
     def watch_vector(self, name: str, u_full: np.ndarray) -> np.ndarray:
@@ -122,27 +127,63 @@ class Structure:
         return F
 
     def compliance_columns(self, Grows: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
-        """K^-1 G^T for rows G (k x nwatch): its watch restriction and its twist q^T K^-1 G^T."""
+        """K^-1 G^T for rows G (k x nwatch): its watch restriction and its twist q^T K^-1 G^T.
+
+        A row's part on one or two nodes of a body is summed from those nodes' responses to
+        unit loads (``NodeColumns``, back-substituted once per node and direction); a part on
+        more nodes is back-substituted whole.
+        """
         k = Grows.shape[0]
         X = np.zeros((self.nwatch, k))
         Xq = np.zeros(k)
         Gt = Grows.T.tocsr()
         for name, b in self.bodies.items():
             sl = slice(b.watch_offset, b.watch_offset + 2 * b.watch_nodes.size)
-            cols = np.flatnonzero(np.diff(Gt[sl].tocsc().indptr))
+            sub = Gt[sl].tocsc()
+            sub.sort_indices()
+            cols = np.flatnonzero(np.diff(sub.indptr))
             if cols.size == 0:
                 continue
-            for c0 in range(0, cols.size, SOLVE_BATCH):
-                cc = cols[c0:c0 + SOLVE_BATCH]
-                Fw = Gt[:, cc].tocsc()
-                F = self.watch_to_body(name, Fw)
-                U = b.solve(F)
-                wn = b.watch_nodes
-                X[b.watch_index[0, wn][:, None], cc[None, :]] += U[b.dofs[0, wn]]
-                X[b.watch_index[1, wn][:, None], cc[None, :]] += U[b.dofs[1, wn]]
-                if name == "fs":
-                    Xq[cc] += self.twist_measure @ U
+            if name in SPLIT_BODIES:
+                split, Xs, Xsq, whole = self._node_columns(name, b).columns(
+                    sub, lambda loads, name=name: self._node_response(name, loads), SOLVE_BATCH)
+                X[sl, split] += Xs
+                Xq[split] += Xsq
+            else:
+                whole = cols
+            for c0 in range(0, whole.size, SOLVE_BATCH):
+                cc = whole[c0:c0 + SOLVE_BATCH]
+                Xw, Xwq = self._watch_response(name, self.watch_to_body(name, Gt[:, cc].tocsc()))
+                X[sl, cc] += Xw
+                Xq[cc] += Xwq
         return X, Xq
+
+    def _node_columns(self, name: str, body: Body) -> NodeColumns:
+        if name not in self._node_cache:
+            self._node_cache[name] = NodeColumns(2 * body.watch_nodes.size)
+        return self._node_cache[name]
+
+    def _node_response(self, name: str, loads: list[tuple[int, np.ndarray]]
+                       ) -> tuple[np.ndarray, np.ndarray]:
+        """``_watch_response`` to unit loads (watched node index, direction) on body ``name``."""
+        b = self.bodies[name]
+        F = np.zeros((b.stiffness.shape[0], len(loads)))
+        for j, (n, d) in enumerate(loads):
+            node = b.watch_nodes[n]
+            F[b.dofs[0, node], j], F[b.dofs[1, node], j] = d
+        return self._watch_response(name, F)
+
+    def _watch_response(self, name: str, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """K^-1 F of body ``name`` (one back-substitution): its twist and its restriction to the
+        body's own watch dofs (the only ones it moves)."""
+        b = self.bodies[name]
+        U = b.solve(F)
+        wn = b.watch_nodes
+        Uw = np.zeros((2 * wn.size, F.shape[1]))
+        Uw[b.watch_index[0, wn] - b.watch_offset] = U[b.dofs[0, wn]]
+        Uw[b.watch_index[1, wn] - b.watch_offset] = U[b.dofs[1, wn]]
+        twist = self.twist_measure @ U if name == "fs" else np.zeros(F.shape[1])
+        return Uw, twist
 
     def rigid_modes(self, modes: list[ModeName]) -> RigidModes:
         """Watch restriction, twist and torque-load component of the free modes ``modes``."""
