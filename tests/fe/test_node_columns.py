@@ -32,15 +32,15 @@ def _direct(structure, G):
     return X, Xq
 
 
-def _rows(structure, angle):
+def _rows(structure, angle, xi):
     """Rows shaped like the contact rows: a slave node on the FS along a normal at ``angle``, a
-    CS master segment (weights 0.3, 0.7) along minus that normal, and an arc average over
-    five OR nodes (back-substituted whole)."""
+    CS master segment (weights 1 - xi, xi) along minus that normal, the same two rows again
+    (negated), and an arc average over five OR nodes (back-substituted whole)."""
     fs, cs, ring = (structure.bodies[n] for n in ("fs", "cs", "or"))
     n = np.array([np.cos(angle), np.sin(angle)])
     r, c, v = [], [], []
-    for row, (body, nodes, weights) in enumerate([(fs, [3], [1.0]), (cs, [10, 11], [-0.3, -0.7]),
-                                                  (fs, [3], [1.0]), (cs, [10, 11], [0.3, 0.7]),
+    for row, (body, nodes, weights) in enumerate([(fs, [3], [1.0]), (cs, [10, 11], [xi - 1, -xi]),
+                                                  (fs, [3], [-1.0]), (cs, [10, 11], [1 - xi, xi]),
                                                   (ring, [0, 1, 2, 3, 4], [0.2] * 5)]):
         for node, w in zip(nodes, weights):
             for k in (0, 1):
@@ -50,21 +50,26 @@ def _rows(structure, angle):
     return sp.csr_matrix((v, (r, c)), shape=(5, structure.nwatch))
 
 
-def test_node_pieces_reproduce_direct_columns_and_are_reused(monkeypatch):
-    """A linear identity: K^-1 of a row is the sum of K^-1 of its node pieces, so the columns
-    agree with one back-substitution per row to round-off, for the normal a row first had and
-    for a re-linearised one; once a node knows two directions, no row on it solves again."""
+def test_node_patterns_reproduce_direct_columns_and_are_reused(monkeypatch):
+    """A linear identity: K^-1 of a row is the combination of K^-1 of the patterns kept for its
+    nodes, so the columns agree with one back-substitution per row to round-off, for the row a
+    pair first had and for re-linearised ones (normal turned, weights moved).  Only a row outside
+    the span of its nodes' patterns solves: a single node's span is full after two directions,
+    a node pair's after four patterns."""
     structure = _structure()
     solved = []      # columns of each back-substitution compliance_columns makes
     original = Body.solve
     monkeypatch.setattr(Body, "solve", lambda self, F: solved.append(F.shape[1]) or original(self, F))
+    sequence = [(0.4, 0.3), (0.4 + 1e-3, 0.3), (2.0, 0.3), (2.0, 0.6), (1.0, 0.6), (2.5, 0.45)]
     results = [(G, *structure.compliance_columns(G))
-               for G in (_rows(structure, a) for a in (0.4, 0.4 + 1e-3, 2.0))]
+               for G in (_rows(structure, angle, xi) for angle, xi in sequence)]
     monkeypatch.undo()
     for G, X, Xq in results:
         Xd, Xqd = _direct(structure, G)
         assert np.abs(X - Xd).max() <= 1e-10 * np.abs(Xd).max()
         assert np.abs(Xq - Xqd).max() <= 1e-10 * np.abs(Xqd).max()
-    # the FS node and the two CS nodes: their first direction, then (a normal turned by 1 mrad)
-    # the perpendicular one, then nothing; the OR row is solved whole every time
-    assert solved == [1, 2, 1] + [1, 2, 1] + [1]
+    # one column a body a solve (the FS, the CS pair, then the OR's whole row): new rows; the
+    # normal turned by 1 mrad (both new); a third normal (the FS node's and the pair's spans hold
+    # it); new weights (the pair's third pattern); new weights and normal (its fourth); then
+    # anything on these nodes is in their span
+    assert solved == [1, 1, 1] + [1, 1, 1] + [1] + [1, 1] + [1, 1] + [1]

@@ -1,42 +1,44 @@
-"""Compliance of loads on single watched nodes, kept per body and reused by later contact rows.
+"""Compliance of loads on one or two nodes of a tooth body, kept and reused by later rows.
 
-A contact row loads at most two nodes of a tooth body: a slave node (its normal) or the two
-ends of a master segment (weights 1 - xi, xi).  Each re-linearisation of the tooth rows (the
-preload ramp, settling at +-T) moves the normal and the weights a little, which made every
-changed row a new back-substitution, two thirds of a design's solve time.  The rows' node
-pieces, though, keep falling on the same nodes: once a node has the responses to two
-perpendicular unit loads, K^-1 of any load on it is their combination, and a row's column is
-the sum of its nodes' pieces.  On hd42-lhs-16 (default half mesh, 0.157 m) that takes the
-back-substitutions of a solve from 4822 columns to about 2230.
+A contact row loads at most two nodes of a tooth body: a slave node (along its normal) or the
+two ends of a master segment (weights 1 - xi, xi).  Each re-linearisation of the tooth rows
+(the preload ramp, settling at +-T) turns the normal and moves the weights a little, and every
+changed row used to be a new back-substitution: two thirds of a heavily loaded design's solve.
+Yet the rows keep falling on the same nodes, and a node pair has only four dofs.  So every
+load this module back-substitutes is kept as a *pattern* on its node set, with its response;
+a new row on nodes S is first projected on the patterns of S and of S's single nodes, and only
+the part outside their span (if larger than ``SPAN_TOL`` of the row) is a new pattern, stored
+normalised.  A row on a node set seen for the first time costs one back-substitution, as
+before; a node pair needs at most four.  On hd42-lhs-16 (default half mesh, 0.157 m) the FS
+and CS columns of a solve fall from 4281 to about 1680.
 
-Rows spread over more nodes (the ball rows' arc averages) gain nothing from it and are
-back-substituted whole, as before.  The node responses are exact columns of K^-1 (not an
-approximation), so a row's column differs from its direct back-substitution by round-off.
+The responses are exact columns of K^-1 and a row's column is an exact combination of them (up
+to ``SPAN_TOL`` of the row), so it differs from its direct back-substitution by round-off.
+Rows spread over more nodes (the ball rows' arc averages) are back-substituted whole.
 """
 
 from __future__ import annotations
 
-import math
 from typing import Callable
 
 import numpy as np
 import scipy.sparse as sp
 
-# the back-substitution of unit loads (node, unit direction) on the body: their responses
+# loads (dofs of the body's watch vector, values) to back-substitute: their responses
 # (n_watch_dofs x k) and twists (k)
-NodeSolve = Callable[[list[tuple[int, np.ndarray]]], tuple[np.ndarray, np.ndarray]]
+PatternSolve = Callable[[list[tuple[np.ndarray, np.ndarray]]], tuple[np.ndarray, np.ndarray]]
 
-# a load piece whose direction is within this (relative cross product) of a node's single known
-# direction reuses it; the neglected part is that small against the piece
-PARALLEL_TOL = 1e-12
-# rows on up to this many nodes of a tooth body are split into node pieces (the balls' rows
-# on the rings barely change between linearisations and gain nothing)
-MAX_NODES_SPLIT = 2
-SPLIT_BODIES = ("fs", "cs")
+# a row whose part outside the known patterns' span is below this fraction of its norm is taken
+# as in the span; the neglected part is that small against the row
+SPAN_TOL = 1e-10
+# rows on up to this many nodes of a tooth body are built from patterns (the balls' rows on
+# the rings are arc averages over many nodes and barely change between linearisations)
+MAX_PATTERN_NODES = 2
+PATTERN_BODIES = ("fs", "cs")
 
 
 class NodeColumns:
-    """Responses (on the body's own watch dofs, and twist) of unit loads on its single nodes.
+    """Responses (on the body's own watch dofs, and twist) of loads on one or two of its nodes.
 
     Parameters
     ----------
@@ -48,7 +50,8 @@ class NodeColumns:
         self._rows = np.zeros((0, n_watch_dofs))   # response j in row j (contiguous)
         self.twist = np.zeros(0)
         self.size = 0
-        self.directions: dict[int, list[tuple[np.ndarray, int]]] = {}   # node -> (unit dir, j)
+        # node set (sorted tuple) -> its patterns: (dofs of that set, unit vector, response index)
+        self.patterns: dict[tuple[int, ...], list[tuple[np.ndarray, int]]] = {}
 
     def _reserve(self, k: int):
         if self.size + k > self._rows.shape[0]:
@@ -60,23 +63,39 @@ class NodeColumns:
             twist[:self.size] = self.twist[:self.size]
             self.twist = twist
 
-    def plan(self, node: int, piece: np.ndarray, pending: list[tuple[int, np.ndarray]]) -> None:
-        """Make ``node`` able to express ``piece``: queue a new unit direction in ``pending``
-        if its known directions do not span it (the first is the piece's own direction, the
-        second perpendicular to the first, so the pair is orthonormal)."""
-        known = self.directions.setdefault(node, [])
-        if len(known) == 2:
-            return
-        size = math.hypot(piece[0], piece[1])
-        if not known:
-            d = piece / size
-        else:
-            d0 = known[0][0]
-            if abs(d0[0] * piece[1] - d0[1] * piece[0]) <= PARALLEL_TOL * size:
-                return
-            d = np.array([-d0[1], d0[0]])
-        known.append((d, self.size + len(pending)))
-        pending.append((node, d))
+    def plan(self, nodes: tuple[int, ...], load: np.ndarray,
+             pending: list[tuple[np.ndarray, np.ndarray]]) -> list[tuple[int, float]]:
+        """(response index, weight) pairs whose sum is the response to ``load``.
+
+        ``load`` holds the x and y components on each of ``nodes`` (sorted).  Its part outside
+        the span of the known patterns on ``nodes`` and on each single one of them becomes a new
+        pattern, queued in ``pending`` (watch dofs, values) for back-substitution.
+        """
+        subsets = [nodes] if len(nodes) == 1 else [(n,) for n in nodes] + [nodes]
+        basis, index = [], []
+        for sub in subsets:
+            where = [2 * nodes.index(n) + k for n in sub for k in (0, 1)]
+            for vec, j in self.patterns.get(sub, ()):
+                col = np.zeros(load.size)
+                col[where] = vec
+                basis.append(col)
+                index.append(j)
+        size = float(np.linalg.norm(load))
+        coef: list[tuple[int, float]] = []
+        rest = load
+        if basis:
+            A = np.array(basis).T
+            c = np.linalg.lstsq(A, load, rcond=None)[0]
+            coef = list(zip(index, c.tolist()))
+            rest = load - A @ c
+        rest_size = float(np.linalg.norm(rest))
+        if rest_size > SPAN_TOL * size:
+            j = self.size + len(pending)
+            self.patterns.setdefault(nodes, []).append((rest / rest_size, j))
+            dofs = np.array([2 * n + k for n in nodes for k in (0, 1)])
+            pending.append((dofs, rest / rest_size))
+            coef.append((j, rest_size))
+        return coef
 
     def add(self, U_watch: np.ndarray, twist: np.ndarray) -> None:
         """Store the responses (n_watch_dofs x k) of the pending loads, in their order."""
@@ -86,16 +105,12 @@ class NodeColumns:
         self.twist[self.size:self.size + k] = twist
         self.size += k
 
-    def coefficients(self, node: int, piece: np.ndarray) -> list[tuple[int, float]]:
-        """(response index, weight) whose sum is the response to ``piece`` on ``node``."""
-        return [(j, float(d @ piece)) for d, j in self.directions[node]]
-
-    def columns(self, G_body: sp.csc_matrix, solve: NodeSolve, batch: int
+    def columns(self, G_body: sp.csc_matrix, solve: PatternSolve, batch: int
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Responses of the rows (columns of ``G_body``, the body's watch dofs x k) on at most
-        ``MAX_NODES_SPLIT`` nodes, from node responses (new ones solved ``batch`` at a time).
+        ``MAX_PATTERN_NODES`` nodes, from patterns (new ones solved ``batch`` at a time).
 
-        Returns the split columns' indices, their responses and twists, and the indices of
+        Returns the indices of those columns, their responses and twists, and the indices of
         the columns left to back-substitute whole.
         """
         k = G_body.shape[1]
@@ -105,26 +120,24 @@ class NodeColumns:
         pieces = np.zeros((key.size, 2))
         np.add.at(pieces, (inv, G_body.indices % 2), G_body.data)
         piece_col, piece_node = key // n_nodes, key % n_nodes
+        nonzero = pieces.any(axis=1)
+        piece_col, piece_node, pieces = piece_col[nonzero], piece_node[nonzero], pieces[nonzero]
         nodes_per_col = np.bincount(piece_col, minlength=k)
-        split = (nodes_per_col > 0) & (nodes_per_col <= MAX_NODES_SPLIT)
-        keep = split[piece_col] & pieces.any(axis=1)
-        piece_col, piece_node, pieces = piece_col[keep], piece_node[keep], pieces[keep]
-        pending: list[tuple[int, np.ndarray]] = []
-        for n, piece in zip(piece_node.tolist(), pieces):
-            self.plan(n, piece, pending)
-        for c0 in range(0, len(pending), batch):
-            self.add(*solve(pending[c0:c0 + batch]))
-        split_cols = np.flatnonzero(split)
-        position = np.cumsum(split) - 1            # column -> its place among the split ones
+        built = np.flatnonzero((nodes_per_col > 0) & (nodes_per_col <= MAX_PATTERN_NODES))
+        start = np.concatenate([[0], np.cumsum(nodes_per_col)])
+        pending: list[tuple[np.ndarray, np.ndarray]] = []
         r, c, v = [], [], []
-        for n, j, piece in zip(piece_node.tolist(), position[piece_col].tolist(), pieces):
-            for i, w in self.coefficients(n, piece):
+        for j, col_k in enumerate(built.tolist()):
+            a, b = start[col_k], start[col_k + 1]
+            for i, w in self.plan(tuple(piece_node[a:b].tolist()), pieces[a:b].ravel(), pending):
                 r.append(i)
                 c.append(j)
                 v.append(w)
-        C = sp.csc_matrix((v, (r, c)), shape=(self.size, split_cols.size))
+        for c0 in range(0, len(pending), batch):
+            self.add(*solve(pending[c0:c0 + batch]))
+        C = sp.csc_matrix((v, (r, c)), shape=(self.size, built.size))
         X, Xq = self.combine(C)
-        return split_cols, X, Xq, np.flatnonzero((nodes_per_col > MAX_NODES_SPLIT))
+        return built, X, Xq, np.flatnonzero(nodes_per_col > MAX_PATTERN_NODES)
 
     def combine(self, C: sp.csc_matrix) -> tuple[np.ndarray, np.ndarray]:
         """Responses (n_watch_dofs x k) and twists (k) of the loads C (size x k) in the stored

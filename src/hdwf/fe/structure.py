@@ -24,7 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from hdwf.fe.bodies import Body
-from hdwf.fe.node_columns import SPLIT_BODIES, NodeColumns
+from hdwf.fe.node_columns import PATTERN_BODIES, NodeColumns
 
 ModeName = tuple[str, str]      # (body, mode), e.g. ("fs", "rot")
 
@@ -129,9 +129,9 @@ class Structure:
     def compliance_columns(self, Grows: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
         """K^-1 G^T for rows G (k x nwatch): its watch restriction and its twist q^T K^-1 G^T.
 
-        A row's part on one or two nodes of a body is summed from those nodes' responses to
-        unit loads (``NodeColumns``, back-substituted once per node and direction); a part on
-        more nodes is back-substituted whole.
+        A row's part on one or two nodes of a tooth body is combined from the responses kept
+        for those nodes (``NodeColumns``: only its part outside their span is back-substituted);
+        a part on more nodes is back-substituted whole.
         """
         k = Grows.shape[0]
         X = np.zeros((self.nwatch, k))
@@ -144,7 +144,7 @@ class Structure:
             cols = np.flatnonzero(np.diff(sub.indptr))
             if cols.size == 0:
                 continue
-            if name in SPLIT_BODIES:
+            if name in PATTERN_BODIES:
                 split, Xs, Xsq, whole = self._node_columns(name, b).columns(
                     sub, lambda loads, name=name: self._node_response(name, loads), SOLVE_BATCH)
                 X[sl, split] += Xs
@@ -163,14 +163,13 @@ class Structure:
             self._node_cache[name] = NodeColumns(2 * body.watch_nodes.size)
         return self._node_cache[name]
 
-    def _node_response(self, name: str, loads: list[tuple[int, np.ndarray]]
+    def _node_response(self, name: str, loads: list[tuple[np.ndarray, np.ndarray]]
                        ) -> tuple[np.ndarray, np.ndarray]:
-        """``_watch_response`` to unit loads (watched node index, direction) on body ``name``."""
+        """``_watch_response`` to loads (the body's watch dofs, values) on body ``name``."""
         b = self.bodies[name]
         F = np.zeros((b.stiffness.shape[0], len(loads)))
-        for j, (n, d) in enumerate(loads):
-            node = b.watch_nodes[n]
-            F[b.dofs[0, node], j], F[b.dofs[1, node], j] = d
+        for j, (dofs, values) in enumerate(loads):
+            F[b.dofs[dofs % 2, b.watch_nodes[dofs // 2]], j] = values
         return self._watch_response(name, F)
 
     def _watch_response(self, name: str, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
