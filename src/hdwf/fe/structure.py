@@ -140,7 +140,6 @@ class Structure:
         for name, b in self.bodies.items():
             sl = slice(b.watch_offset, b.watch_offset + 2 * b.watch_nodes.size)
             sub = Gt[sl].tocsc()
-            sub.sort_indices()
             cols = np.flatnonzero(np.diff(sub.indptr))
             if cols.size == 0:
                 continue
