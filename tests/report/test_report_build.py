@@ -114,7 +114,7 @@ def test_knee_section_fits_both_models(named_inputs, tmp_path):
 
     import pandas as pd
 
-    from hdwf.report.fe_part import knee_section
+    from hdwf.report.knee_part import knee_section
 
     paper = study_artefacts("paper", STUDY, artefacts_by_owner(*named_inputs))
     table = pd.read_parquet(paper.drive("hd42").lost_motion)
@@ -219,3 +219,39 @@ def test_ladder_is_held_against_the_bearing_rating():
     assert "from rung 1 on" in said and "dent" in said
     assert "Every rung stays within it" in _bearing_sentence(lad.iloc[:1])
     assert _bearing_sentence(lad.drop(columns=["specimens_checked"])) == ""
+
+
+def test_rank_split_section_finds_the_rank_lost_on_the_flat_part(named_inputs, tmp_path):
+    """Ours = the paper's Φ with the 13 designs of its flat part in reverse order: past the knee
+    ρ is 1, on the flat part −1; the paper's own hinge ranks Table 4 at 0.910
+    (tests/study/test_knee.py); the section typesets."""
+    import dataclasses
+
+    import numpy as np
+    import pandas as pd
+
+    from hdwf.report.knee_part import rank_split_section
+    from hdwf.study.knee import fit_hinge
+    from hdwf.study.paper import load_bounds
+
+    paper = study_artefacts("paper", STUDY, artefacts_by_owner(*named_inputs))
+    table = pd.read_parquet(paper.drive("hd42").lost_motion)
+    nominal = load_bounds(DATA, "hd42").loc["nominal"]
+    fit = fit_hinge(table, nominal)
+    flat = fit.clearance_um(table, nominal) < fit.knee_um
+    values = table["lost_motion_arcmin"].to_numpy(float, copy=True)
+    order = np.argsort(values[flat])
+    values[np.flatnonzero(flat)[order]] = values[flat][order[::-1]]
+    table["lost_motion_arcmin"] = values
+    table.to_parquet(tmp_path / "reversed.parquet")
+    ours = dataclasses.replace(paper, name="fe_at_paper", source="fe",
+                               drives=(dataclasses.replace(paper.drive("hd42"), lost_motion=tmp_path / "reversed.parquet"),))
+    doc = Document("t", "s", PROVENANCE)
+    rank_split_section(doc, ["hd42"], DATA, paper, ours, 0.9)
+    rows = next(b for b in doc.blocks if b["type"] == "table")["rows"]
+    assert rows[0][1] == "13 of 27" and rows[0][2] == "0.910"
+    assert rows[0][5:] == ["-1.00", "1.00"]
+    assert "it ranks worse on the flat part" in doc.blocks[-1]["text"]
+    pdf = doc.compile(tmp_path / "ranks.pdf")
+    if shutil.which("pdftotext"):
+        assert "Where the rank is lost" in _pdf_text(pdf)

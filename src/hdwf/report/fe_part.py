@@ -18,10 +18,10 @@ from hdwf.fe.hertz import ISO76_BALL_PRESSURE_MPA
 from hdwf.fe.solver import TOL_GAP
 from hdwf.report.artefacts import FeSettings, ReportInputs, StudyArtefacts
 from hdwf.report.document import UNIT_NAMES, Document, fmt, lit, math_label
-from hdwf.report.figures import agreement_figure, curves_figure, knee_figure
+from hdwf.report.figures import agreement_figure, curves_figure
+from hdwf.report.knee_part import knee_section, rank_split_section
 from hdwf.report.paper_part import correlation_section, exact_sobol, sobol_section, surrogate_section
-from hdwf.study.knee import fit_hinge, offset_slopes
-from hdwf.study.paper import load_bounds, load_published
+from hdwf.study.paper import load_published
 from hdwf.validation.effects import get as get_effect
 
 
@@ -328,55 +328,6 @@ def agreement_section(doc: Document, units: list[str], paper: StudyArtefacts, ou
                  "Part III search for the effect that does, and the knee below shows what is left.")
 
 
-def knee_section(doc: Document, units: list[str], data_dir: Path, paper: StudyArtefacts, ours: StudyArtefacts,
-                 tmp: Path, level: int = 1) -> None:
-    """The knee: Φ against the clearance s, ours and the paper's, each with its hinge fit
-    (``hdwf.study.knee``), and the least-squares dΦ/dr_FS of both.
-
-    Parameters
-    ----------
-    doc
-        The document to add to.
-    units
-        The drives both studies have.
-    data_dir
-        The paper's tables (Table 3's nominal design is the origin of the radial changes).
-    paper, ours
-        The study on the paper's tables and the FE study at its design points.
-    tmp
-        A scratch folder for the figure; it must outlive ``doc.compile``.
-    level
-        Heading level of the section.
-    """
-    doc.heading("The knee: lost motion against clearance", level)
-    rows, panels = [], {}
-    for u in units:
-        nominal = load_bounds(data_dir, u).loc["nominal"]
-        models, slopes = {}, {}
-        for name, study in (("paper", paper), ("ours", ours)):
-            table = pd.read_parquet(study.drive(u).lost_motion)
-            fit = fit_hinge(table, nominal)
-            slopes[name] = offset_slopes(table)[0]
-            ok = table["lost_motion_arcmin"].notna().to_numpy()
-            models[name] = (fit.clearance_um(table[ok], nominal), table["lost_motion_arcmin"].to_numpy(float)[ok], fit)
-            rows.append([UNIT_NAMES[u], name, fmt(fit.floor_arcmin, 3), fmt(fit.knee_um, 1),
-                         fmt(fit.slope_arcmin_per_um, 4), ", ".join(fmt(w, 3) for w in fit.weights), fmt(fit.r2, 3),
-                         fmt(slopes[name], 4)])
-        rows[-1][-1] += f" ({fmt(slopes['ours'] / slopes['paper'], 2)}×)"
-        panels[UNIT_NAMES[u]] = models
-    doc.table(["drive", "model", "floor $a$", "knee $s_0$ (µm)", "slope $b$ (arcmin/µm)", "weights $w_d, w_D, w_G$",
-               "$R^2$", "least-squares $d Phi slash d r_\"FS\"$ (arcmin/µm)"], rows,
-              "Hinge fits $Phi = a + b max(0, s - s_0)$, $s = r_\"FS\" + r_\"CS\" + w_d Delta d slash 2 + "
-              "w_D Delta D slash 2 + w_G Delta G_r slash 2$ (µm, $Delta$ from Table 3's nominal design, weights "
-              "fitted per model), and the $r_\"FS\"$ coefficient of a linear fit in all five parameters (in "
-              "brackets: ours over the paper's).")
-    path = tmp / "knee.png"
-    knee_figure(panels, "Lost motion against clearance: the paper's FEA and ours, with hinge fits", path)
-    doc.figure(path, "Each model's $Phi$ against its own clearance $s$ (its fitted weights), with its hinge; a "
-               "dotted line marks a knee inside the table. A flat part means a preload takes up the first "
-               "micrometres of offset.", width="100%" if len(panels) > 1 else "55%")
-
-
 def _indices_rows(pub: pd.DataFrame, unit: str, studies: list[StudyArtefacts]) -> list[list[str]]:
     """Per parameter: the paper's published indices, then each study's exact ones."""
     exact = [exact_sobol(s.drive(unit).sobol) for s in studies]
@@ -454,6 +405,8 @@ def fe_part(doc: Document, report: ReportInputs, tmp: Path) -> None:
         units = [u for u in at_paper[0].units if u in paper_studies[0].units]
         agreement_section(doc, units, paper_studies[0], at_paper[0], tmp, report.fe_settings, 2)
         knee_section(doc, units, report.data_dir, paper_studies[0], at_paper[0], tmp, 2)
+        rank_split_section(doc, units, report.data_dir, paper_studies[0], at_paper[0],
+                           AGREEMENT_TARGETS["spearman"], 2)
     all_units = sorted({u for s in fe_studies for u in s.units}, key=["hd42", "hd120"].index)
     indices_vs_paper_section(doc, all_units, report.data_dir, paper_studies + fe_studies, 2)
     for study in fe_studies:

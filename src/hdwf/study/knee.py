@@ -12,6 +12,10 @@ no flat part: its knee lies below the smallest s of the table.
 
 ``offset_slopes`` is the plainer number: dΦ/dr_FS and dΦ/dr_CS of a linear least-squares fit in
 all five parameters (arcmin/µm).
+
+``floor_ranks`` says where a model's rank against a reference (the paper's Φ) is won or lost: on
+the reference's flat part or past its knee. It also gives what the reference's own hinge would
+rank, and the linear trend hidden in its "flat" part, which a hinge cannot rank.
 """
 
 from __future__ import annotations
@@ -21,11 +25,14 @@ from typing import Mapping
 
 import numpy as np
 import pandas as pd
+import statsmodels.api as sm
 from scipy.optimize import least_squares
+from scipy.stats import rankdata, spearmanr
 
 from hdwf import PARAMETER_COLUMNS
 
 RADIAL = ("d_mm", "D_mm", "Gr_mm")   # the radial changes weighted into the clearance, in this order
+MIN_FLOOR_DESIGNS = 11               # a linear fit in five parameters with 5 degrees of freedom left
 
 
 @dataclass(frozen=True)
@@ -136,3 +143,102 @@ def offset_slopes(designs: pd.DataFrame, column: str = "lost_motion_arcmin") -> 
     A = np.column_stack([np.ones(len(table)), table[list(PARAMETER_COLUMNS)].to_numpy(float)])
     coef = dict(zip(("intercept", *PARAMETER_COLUMNS), np.linalg.lstsq(A, table[column].to_numpy(float), rcond=None)[0]))
     return float(coef["rFS_mm"]) * 1e-3, float(coef["rCS_mm"]) * 1e-3
+
+
+@dataclass(frozen=True)
+class FloorRanks:
+    """A model's rank against a reference, split at the reference's knee.
+
+    Attributes
+    ----------
+    n, n_floor : int
+        Designs compared (both Φ known), and those on the reference's flat part (s below its knee).
+    floor_coefficients : tuple of float
+        The reference's Φ on its flat part, a linear fit in d, D, G_r, r_FS, r_CS: arcmin per µm of
+        each (of the diameter for d and D); NaN with fewer than ``MIN_FLOOR_DESIGNS`` flat designs.
+    floor_r2, floor_p : float
+        R² of that fit and the p-value of its F-test (is the flat part flat?).
+    spearman_hinge : float
+        Spearman ρ of the reference against its own hinge, the flat designs tied.
+    spearman_ceiling : float
+        The same with the flat designs' order random (a model with the reference's hinge but not its
+        flat part's trend), mean over the draws.
+    share_at_least : float
+        Share of those draws whose ρ reaches ``threshold``.
+    threshold : float
+        The rank target the share counts.
+    spearman_all, spearman_floor, spearman_past : float
+        Spearman ρ of the model against the reference: all designs, the flat ones, those past the knee.
+    """
+
+    n: int
+    n_floor: int
+    floor_coefficients: tuple[float, ...]
+    floor_r2: float
+    floor_p: float
+    spearman_hinge: float
+    spearman_ceiling: float
+    share_at_least: float
+    threshold: float
+    spearman_all: float
+    spearman_floor: float
+    spearman_past: float
+
+
+def _rho(a: np.ndarray, b: np.ndarray) -> float:
+    return float(spearmanr(a, b)[0]) if len(a) >= 3 else float("nan")
+
+
+def floor_ranks(reference: pd.DataFrame, model_arcmin: np.ndarray, nominal: Mapping[str, float], *,
+                threshold: float = 0.9, draws: int = 2000, seed: int = 0,
+                column: str = "lost_motion_arcmin") -> FloorRanks:
+    """Split the rank of ``model_arcmin`` against ``reference`` at the reference's knee.
+
+    Parameters
+    ----------
+    reference : DataFrame
+        One row per design: the five ``*_mm`` columns and ``column`` (e.g. the paper's Table 4).
+    model_arcmin : array
+        The model's Φ at the same designs, in the same order; NaN where a solve failed.
+    nominal : Mapping
+        Table 3's nominal design (the origin of the clearance s).
+    threshold : float
+        The rank target whose reach the random-order draws count.
+    draws, seed : int
+        Random orders of the flat designs, seeded.
+    column : str
+        The reference's lost-motion column.
+
+    Returns
+    -------
+    FloorRanks
+    """
+    model = np.asarray(model_arcmin, float)
+    if len(model) != len(reference):
+        raise ValueError(f"model has {len(model)} values for {len(reference)} reference designs")
+    keep = np.isfinite(model) & np.isfinite(reference[column].to_numpy(float))
+    table, model = reference[keep].reset_index(drop=True), model[keep]
+    fit = fit_hinge(table, nominal, column)
+    y = table[column].to_numpy(float)
+    flat = fit.clearance_um(table, nominal) < fit.knee_um
+    hinge = fit.predict(fit.clearance_um(table, nominal))
+
+    floor = table[flat]
+    coefficients, r2, p = (float("nan"),) * len(PARAMETER_COLUMNS), float("nan"), float("nan")
+    if len(floor) >= MIN_FLOOR_DESIGNS:
+        X = sm.add_constant(1e3 * (floor[list(PARAMETER_COLUMNS)] - pd.Series(nominal)[list(PARAMETER_COLUMNS)]),
+                            has_constant="add")
+        ols = sm.OLS(floor[column].to_numpy(float), X).fit()
+        coefficients = tuple(float(ols.params[c]) for c in PARAMETER_COLUMNS)
+        r2, p = float(ols.rsquared), float(ols.f_pvalue)
+
+    rng = np.random.default_rng(seed)
+    ordered = np.tile(hinge, (draws, 1))
+    # the flat designs keep their common value, in a random order far finer than any step of the hinge
+    ordered[:, flat] += 1e-9 * rng.permuted(np.tile(np.arange(flat.sum()), (draws, 1)), axis=1)
+    rhos = np.corrcoef(rankdata(y), rankdata(ordered, axis=1))[0, 1:]
+    return FloorRanks(n=len(table), n_floor=int(flat.sum()), floor_coefficients=coefficients, floor_r2=r2, floor_p=p,
+                      spearman_hinge=_rho(y, hinge), spearman_ceiling=float(rhos.mean()),
+                      share_at_least=float(np.mean(rhos >= threshold)), threshold=threshold,
+                      spearman_all=_rho(y, model), spearman_floor=_rho(y[flat], model[flat]),
+                      spearman_past=_rho(y[~flat], model[~flat]))
