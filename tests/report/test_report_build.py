@@ -250,7 +250,7 @@ def test_rank_split_section_finds_the_rank_lost_on_the_flat_part(named_inputs, t
     rank_split_section(doc, ["hd42"], DATA, paper, ours, 0.9)
     rows = next(b for b in doc.blocks if b["type"] == "table")["rows"]
     assert rows[0][1] == "13 of 27" and rows[0][2] == "0.910"
-    assert rows[0][5:] == ["-1.00", "1.00"]
+    assert rows[0][4] == "0.938" and rows[0][6:] == ["-1.00", "1.00"]
     assert "it ranks worse on the flat part" in doc.blocks[-1]["text"]
     pdf = doc.compile(tmp_path / "ranks.pdf")
     if shutil.which("pdftotext"):

@@ -120,9 +120,11 @@ def test_the_papers_flat_part_is_not_flat(paper_dir):
     assert np.sign(ranks.floor_coefficients).tolist() == [1, -1, 1, 1, 1]   # a looser fit, more play
     assert ranks.spearman_hinge == pytest.approx(0.9104, abs=5e-4)
     assert ranks.spearman_ceiling == pytest.approx(0.859, abs=0.01) and ranks.share_at_least < 0.2
+    assert ranks.spearman_clearance == pytest.approx(0.938, abs=5e-4)   # Φ rising strictly with s would pass
     hd120 = floor_ranks(load_fea_designs(paper_dir, "hd120"), load_fea_designs(paper_dir, "hd120")["lost_motion_arcmin"]
                         .to_numpy(), _nominal(paper_dir, "hd120"))
     assert hd120.n_floor == 7 and np.isnan(hd120.floor_r2)   # too few for a fit in five parameters
+    assert hd120.spearman_clearance == pytest.approx(0.964, abs=5e-4)
 
 
 def test_floor_ranks_names_a_length_mismatch(paper_dir):

@@ -107,14 +107,18 @@ def rank_split_section(doc: Document, units: list[str], data_dir: Path, paper: S
         found[u] = ranks
         rows.append([UNIT_NAMES[u], f"{ranks.n_floor} of {ranks.n}", fmt(ranks.spearman_hinge, 3),
                      f"{fmt(ranks.spearman_ceiling, 3)} ({100 * ranks.share_at_least:.0f} %)",
+                     fmt(ranks.spearman_clearance, 3),
                      fmt(ranks.spearman_all, 3), fmt(ranks.spearman_floor, 2), fmt(ranks.spearman_past, 2)])
         trends.append([UNIT_NAMES[u], _trend_text(ranks)])
     doc.table(["drive", "designs on the paper's flat part", "$rho$ paper vs its own hinge",
-               f"same, flat part in random order: mean (share $>= {threshold}$)", "$rho$ ours vs paper: all",
+               f"same, flat part in random order: mean (share $>= {threshold}$)",
+               "$rho$ paper vs its clearance $s$, equal weights", "$rho$ ours vs paper: all",
                "flat part", "past the knee"], rows,
               "Spearman $rho$ split at the paper's knee (its hinge fit above). The hinge ties the designs of its "
               "flat part; the random-order column is what a model with the paper's hinge but no order among "
-              "those designs would rank (2000 seeded orders).")
+              "those designs would rank (2000 seeded orders). Equal weights: $s = r_\"FS\" + r_\"CS\" + "
+              "(Delta d - Delta D + Delta G_r) slash 2$, every radial loosening counting like an offset; any "
+              "model whose $Phi$ rises strictly with it ranks as that column.")
     doc.table(["drive", "paper's $Phi$ on its flat part: linear trend, arcmin per µm of each input"], trends,
               "A linear fit in the five inputs over the designs below the paper's knee (µm of diameter for "
               "$d$, $D$); p of its F-test.")
@@ -125,11 +129,12 @@ def rank_split_section(doc: Document, units: list[str], data_dir: Path, paper: S
                     f"{fmt(ranks.spearman_floor, 2)} and the {ranks.n - ranks.n_floor} past the knee at "
                     f"{fmt(ranks.spearman_past, 2)}: it ranks worse {worse}. A model with the paper's own "
                     f"hinge would reach $rho >= {threshold}$ in {100 * ranks.share_at_least:.0f} % of the "
-                    f"orders of the flat designs (mean {fmt(ranks.spearman_ceiling, 3)}).")
+                    f"orders of the flat designs (mean {fmt(ranks.spearman_ceiling, 3)}); one whose $Phi$ rises "
+                    f"strictly with the clearance $s$ (equal weights) ranks at {fmt(ranks.spearman_clearance, 3)}.")
     below = [UNIT_NAMES[u] for u, ranks in found.items() if ranks.spearman_ceiling < threshold]
     if below:
         text.append(f"On {' and '.join(below)} the target asks for more than the paper's own hinge gives: the "
                     "order within the paper's flat part, whose $Phi$ still rises with the clearances (the trend "
                     "table), as a preloaded engagement that softens as the offsets relieve it would. A flat "
-                    "floor has no such order.")
+                    "floor has no such order; a $Phi$ rising strictly with the clearance has.")
     doc.text(" ".join(text))

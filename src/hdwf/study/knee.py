@@ -33,6 +33,9 @@ from hdwf import PARAMETER_COLUMNS
 
 RADIAL = ("d_mm", "D_mm", "Gr_mm")   # the radial changes weighted into the clearance, in this order
 MIN_FLOOR_DESIGNS = 11               # a linear fit in five parameters with 5 degrees of freedom left
+# every radial loosening (a looser bore, a smaller outer ring, more clearance) counting like an offset;
+# the paper's own hinge weights are 1.1-1.2 for d and G_r (HD 42) and for d and D (HD 120)
+EQUAL_WEIGHTS = (1.0, -1.0, 1.0)
 
 
 @dataclass(frozen=True)
@@ -165,6 +168,9 @@ class FloorRanks:
         flat part's trend), mean over the draws.
     share_at_least : float
         Share of those draws whose ρ reaches ``threshold``.
+    spearman_clearance : float
+        Spearman ρ of the reference against its clearance s with ``EQUAL_WEIGHTS``: what any model
+        whose Φ rises strictly with that s would rank.
     threshold : float
         The rank target the share counts.
     spearman_all, spearman_floor, spearman_past : float
@@ -179,6 +185,7 @@ class FloorRanks:
     spearman_hinge: float
     spearman_ceiling: float
     share_at_least: float
+    spearman_clearance: float
     threshold: float
     spearman_all: float
     spearman_floor: float
@@ -239,6 +246,7 @@ def floor_ranks(reference: pd.DataFrame, model_arcmin: np.ndarray, nominal: Mapp
     rhos = np.corrcoef(rankdata(y), rankdata(ordered, axis=1))[0, 1:]
     return FloorRanks(n=len(table), n_floor=int(flat.sum()), floor_coefficients=coefficients, floor_r2=r2, floor_p=p,
                       spearman_hinge=_rho(y, hinge), spearman_ceiling=float(rhos.mean()),
-                      share_at_least=float(np.mean(rhos >= threshold)), threshold=threshold,
+                      share_at_least=float(np.mean(rhos >= threshold)),
+                      spearman_clearance=_rho(y, clearance_um(table, nominal, EQUAL_WEIGHTS)), threshold=threshold,
                       spearman_all=_rho(y, model), spearman_floor=_rho(y[flat], model[flat]),
                       spearman_past=_rho(y[~flat], model[~flat]))
