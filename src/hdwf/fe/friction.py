@@ -25,7 +25,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from hdwf.fe.contact_rows import PairId, Rows, slip_rows_of, stack_slip_rows
-from hdwf.fe.working_set import AddedPairs, ColumnStore, RefreshedPairs, WorkingSet
+from hdwf.fe.column_store import ColumnStore
+from hdwf.fe.working_set import AddedPairs, RefreshedPairs, WorkingSet
 from hdwf.fe.structure import Structure
 
 FRICTION_MAX_IT = 30     # slip-direction iterations per load level (flank friction)

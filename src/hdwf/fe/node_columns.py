@@ -24,6 +24,8 @@ from typing import Callable
 import numpy as np
 import scipy.sparse as sp
 
+from hdwf.fe.column_store import ColumnStore
+
 # loads (dofs of the body's watch vector, values) to back-substitute: their responses
 # (n_watch_dofs x k) and twists (k)
 PatternSolve = Callable[[list[tuple[np.ndarray, np.ndarray]]], tuple[np.ndarray, np.ndarray]]
@@ -47,21 +49,14 @@ class NodeColumns:
     """
 
     def __init__(self, n_watch_dofs: int):
-        self._rows = np.zeros((0, n_watch_dofs))   # response j in row j (contiguous)
-        self.twist = np.zeros(0)
-        self.size = 0
+        self._store = ColumnStore(n_watch_dofs + 1)   # a response, then its twist, per row
         # node set (sorted tuple) -> its patterns: (dofs of that set, unit vector, response index)
         self.patterns: dict[tuple[int, ...], list[tuple[np.ndarray, int]]] = {}
 
-    def _reserve(self, k: int):
-        if self.size + k > self._rows.shape[0]:
-            cap = max(self._rows.shape[0] * 3 // 2, self.size + k, 256)
-            grown = np.zeros((cap, self._rows.shape[1]))
-            grown[:self.size] = self._rows[:self.size]
-            self._rows = grown
-            twist = np.zeros(cap)
-            twist[:self.size] = self.twist[:self.size]
-            self.twist = twist
+    @property
+    def size(self) -> int:
+        """Responses stored."""
+        return self._store.size
 
     def plan(self, nodes: tuple[int, ...], load: np.ndarray,
              pending: list[tuple[np.ndarray, np.ndarray]]) -> list[tuple[int, float]]:
@@ -99,11 +94,7 @@ class NodeColumns:
 
     def add(self, U_watch: np.ndarray, twist: np.ndarray) -> None:
         """Store the responses (n_watch_dofs x k) of the pending loads, in their order."""
-        k = U_watch.shape[1]
-        self._reserve(k)
-        self._rows[self.size:self.size + k] = U_watch.T
-        self.twist[self.size:self.size + k] = twist
-        self.size += k
+        self._store.append(np.vstack([U_watch, twist[None, :]]))
 
     def columns(self, G_body: sp.csc_matrix, solve: PatternSolve, batch: int
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -142,5 +133,5 @@ class NodeColumns:
     def combine(self, C: sp.csc_matrix) -> tuple[np.ndarray, np.ndarray]:
         """Responses (n_watch_dofs x k) and twists (k) of the loads C (size x k) in the stored
         basis."""
-        R = self._rows[:self.size]
-        return np.asarray((C.T @ R).T), C.T @ self.twist[:self.size]
+        both = np.asarray(C.T @ self._store.columns.T).T
+        return both[:-1], both[-1]
