@@ -258,3 +258,52 @@ def test_rigid_lost_motion_with_a_deeper_cam_follows_the_tooth_path(kappa):
     r = solve_lost_motion(g, mesh, steps_per_ramp=1, E=g.E * 1e4)
     assert r.status == "ok", r.reason
     assert r.lost_motion_arcmin == pytest.approx(_rack_path_backlash_arcmin(g, kappa), rel=0.03)
+
+
+def test_flank_layer_is_a_steel_layer_so_many_modules_thick():
+    """c = thickness m / E: 1166.67 modules of HD 42 (m 0.18 mm) give 1 um per MPa."""
+    from hdwf.fe.changes import ModelChanges
+    assert ModelChanges(flank_layer_m=210.0 / 0.18).layer_um_per_MPa(0.18, 210_000.0) == pytest.approx(1.0)
+    assert ModelChanges().layer_um_per_MPa(0.18, 210_000.0) == 0.0
+
+
+def _flank_layer_stiffness(refinement: float, layer_um_per_MPa: float) -> float:
+    """Sum of 1/s over the FS slave rows (every FS tooth of the half model, N/mm) on a mesh."""
+    import dataclasses
+    g = dataclasses.replace(drive_geometry(*NOMINAL, interference_m=0.1), flank_layer_um_per_MPa=layer_um_per_MPa)
+    model = LostMotionModel(g, build_mesh(g, **COARSE, refinement=refinement, symmetry="half"), zone_deg=90.0)
+    mounted = mount_wave_generator(model)
+    rows = tooth_rows(model.structure, g, mounted.solution.u_watch, np.inf)
+    return float(np.sum(1.0 / rows.compliance[:rows.slave_nodes[0].size]))
+
+
+def test_flank_layer_stiffness_is_the_flank_area_over_c():
+    """The layer is a constant compliance per unit area, spread over the nodes by their share of
+    the flank: over the FS teeth the pairs' stiffnesses add up to face width x outline length / c
+    on any mesh (1.5x finer: within 0.5 %), and halve when c doubles; the outline of the z/2
+    teeth of the half model lies between z/2 twice the tooth height and z/2 pitches plus that."""
+    coarse, fine = _flank_layer_stiffness(1.0, 1.0), _flank_layer_stiffness(1.5, 1.0)
+    assert fine == pytest.approx(coarse, rel=0.005)
+    assert _flank_layer_stiffness(1.0, 2.0) == pytest.approx(coarse / 2.0, rel=1e-12)
+    g = drive_geometry(*NOMINAL)
+    height, teeth = g.r_fs_tip - g.r_fs_root, g.z_fs / 2
+    outline = coarse * 1e-3 / g.face_fs      # N/mm * mm/MPa / mm = mm of outline
+    assert teeth * 2 * height < outline < teeth * (2 * height + 2 * math.pi * g.r_fs_pitch / g.z_fs)
+
+
+@pytest.mark.slow
+def test_flank_layer_softens_a_preloaded_drive_and_vanishes_with_c():
+    """A preloaded drive (0.157 m) with a flank layer has more lost motion (the penetration check
+    allows the layer's approach s p), a vanishing layer gives the drive without one, and the
+    effect's parameter (``ModelChanges.flank_layer_m``) gives the same solve."""
+    import dataclasses
+    g = drive_geometry(*NOMINAL, interference_m=0.157, tip_relief=1.1)
+    mesh = build_mesh(g, **COARSE, symmetry="half")
+    phi = {c: solve_lost_motion(dataclasses.replace(g, flank_layer_um_per_MPa=c), mesh, steps_per_ramp=1)
+           for c in (0.0, 1e-6, 0.3)}
+    assert all(r.status == "ok" for r in phi.values()), [r.reason for r in phi.values()]
+    assert phi[1e-6].lost_motion_arcmin == pytest.approx(phi[0.0].lost_motion_arcmin, abs=1e-4)
+    assert phi[0.3].lost_motion_arcmin > 2 * phi[0.0].lost_motion_arcmin
+    from hdwf.fe.changes import ModelChanges   # the effect's way in: the same layer in modules
+    via = solve_lost_motion(g, mesh, steps_per_ramp=1, changes=ModelChanges(flank_layer_m=0.3e-3 * g.E / g.module))
+    assert via.lost_motion_arcmin == pytest.approx(phi[0.3].lost_motion_arcmin, abs=1e-9)

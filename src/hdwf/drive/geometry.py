@@ -224,6 +224,9 @@ class DriveGeometry:
     # how r_FS, r_CS move a flank: "normal" (a normal offset of r) or "radial" (a rack shift
     # of r, i.e. a normal offset of r sin(alpha))
     offset_direction: str = "normal"
+    # compliance of a layer on the flanks (um of approach per MPa of contact pressure, 0 = none):
+    # the 3D cup's compliance under each tooth, spread over the flank (``contact_rows``)
+    flank_layer_um_per_MPa: float = 0.0
 
     # ---- derived quantities -------------------------------------------------------
     @property

@@ -44,6 +44,11 @@ class ModelChanges:
       on each flank (``DriveGeometry.interference_m``), their tips relieved as a preload needs
       (``hdwf.drive.relief.PRELOAD_TIP_RELIEF``). It changes the section's outline, so the
       geometry must carry it (``geometry_part``): a variant with it is meshed on its own.
+    * ``flank_layer_m``: a compliant layer on the tooth flanks, as compliant as a steel layer
+      this many modules thick: c = flank_layer_m m / E (mm of approach per MPa of contact
+      pressure), in series with every tooth pair over its share of the flank (``contact_rows``).
+      It stands for compliance under each tooth that a plane section lacks (the 3D cup and
+      face); the mesh is unchanged, the solve carries it (``DriveGeometry.flank_layer_um_per_MPa``).
     """
     flank_friction: float = 0.0
     cs_rim_stiffness_N_mm2: float = math.inf
@@ -52,6 +57,11 @@ class ModelChanges:
     output_play_rad: float = 0.0
     output_microslip_loop_rad: float = 0.0
     flank_interference_m: float = 0.0
+    flank_layer_m: float = 0.0
+
+    def layer_um_per_MPa(self, module_mm: float, E_MPa: float) -> float:
+        """The flank layer's compliance (um per MPa) of a drive of this module and modulus."""
+        return 1e3 * self.flank_layer_m * module_mm / E_MPa
 
     def geometry_part(self) -> dict[str, float]:
         """The ``drive_geometry`` arguments these changes need (``interference_m``, ``tip_relief``)."""

@@ -64,6 +64,7 @@ class Rows:
     slip: sp.csr_matrix | None = None         # (n, nwatch) tangential slip rows
     tooth: np.ndarray | None = None           # FS tooth id of every pair
     slave_nodes: tuple[np.ndarray, np.ndarray] | None = None   # (FS nodes, CS nodes)
+    compliance: np.ndarray | None = None      # (n,) mm/N of a layer in series with each pair
 
 
 @dataclass(frozen=True)
@@ -72,6 +73,7 @@ class StackedRows:
     G: sp.csr_matrix
     g0: np.ndarray
     ids: list[PairId]
+    compliance: np.ndarray        # (n,) mm/N in series with each pair (0: none)
 
 
 def stack_rows(rows: dict[str, Rows]) -> StackedRows:
@@ -91,7 +93,9 @@ def stack_rows(rows: dict[str, Rows]) -> StackedRows:
     G = sp.vstack([rows[k].G for k in kinds]).tocsr()
     g0 = np.concatenate([rows[k].g0 for k in kinds])
     ids = [(k, i) for k in kinds for i in range(rows[k].G.shape[0])]
-    return StackedRows(G, g0, ids)
+    compliance = np.concatenate([rows[k].compliance if rows[k].compliance is not None
+                                 else np.zeros(rows[k].G.shape[0]) for k in kinds])
+    return StackedRows(G, g0, ids, compliance)
 
 
 def stack_slip_rows(rows: dict[str, Rows], nwatch: int) -> sp.csr_matrix:
@@ -375,6 +379,11 @@ def tooth_rows(structure: Structure, geom: DriveGeometry, u_watch: np.ndarray, c
     sn_fs, sn_cs = sn_fs[fs_pass.kept], sn_cs[cs_pass.kept]
     # which FS tooth a pair belongs to (teeth in contact); the half model's tooth z/2
     # is the image of tooth 0 (ids modulo z/2; counted twice)
+    compliance = None
+    if geom.flank_layer_um_per_MPa > 0:
+        compliance = 1e-3 * geom.flank_layer_um_per_MPa / np.concatenate(
+            [geom.face_fs * _tributary_length(fs, "fs_teeth", sn_fs),
+             geom.face_cs * _tributary_length(cs, "cs_teeth", sn_cs)])
     zid = geom.z_fs // 2 if structure.half else geom.z_fs
     th = np.concatenate([np.arctan2(fs.x[1, sn_fs], fs.x[0, sn_fs]),
                          np.arctan2(cs.x[1, sn_cs], cs.x[0, sn_cs])])
@@ -382,4 +391,14 @@ def tooth_rows(structure: Structure, geom: DriveGeometry, u_watch: np.ndarray, c
     return Rows("tooth", sp.vstack([fs_pass.G, cs_pass.G]).tocsr(),
                 np.concatenate([fs_pass.g0, cs_pass.g0]),
                 slip=sp.vstack([fs_pass.slip, cs_pass.slip]).tocsr(), tooth=tooth,
-                slave_nodes=(sn_fs, sn_cs))
+                slave_nodes=(sn_fs, sn_cs), compliance=compliance)
+
+
+def _tributary_length(body: Body, edge_set: str, nodes: np.ndarray) -> np.ndarray:
+    """Half the length of the boundary edges of ``edge_set`` at each of ``nodes`` (mm)."""
+    E = body.body_mesh.edge_sets[edge_set]
+    length = np.hypot(*(body.x[:, E[:, 1]] - body.x[:, E[:, 0]]))
+    per_node = np.zeros(body.x.shape[1])
+    np.add.at(per_node, E[:, 0], 0.5 * length)
+    np.add.at(per_node, E[:, 1], 0.5 * length)
+    return per_node[nodes]

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import copy
 import math
-from dataclasses import fields
+from dataclasses import fields, replace
 
 import numpy as np
 
@@ -53,6 +53,13 @@ def _watch_nodes(bms: dict[str, BodyMesh], zone_deg: float) -> dict[str, np.ndar
     }
 
 
+def with_flank_layer(geom: DriveGeometry, changes: ModelChanges) -> DriveGeometry:
+    """``geom`` carrying the flank layer of ``changes``; ``geom`` as it is when they have none."""
+    if changes.flank_layer_m == 0:
+        return geom
+    return replace(geom, flank_layer_um_per_MPa=changes.layer_um_per_MPa(geom.module, geom.E))
+
+
 class LostMotionModel:
     """Holds the factorised bodies, the contact rows and the contact solver's state.
 
@@ -65,8 +72,9 @@ class LostMotionModel:
     def __init__(self, geom: DriveGeometry, mesh: DriveMesh, E: float | None = None,
                  max_iter: int = 200, tol_gap: float = TOL_GAP, zone_deg: float = ZONE_DEG,
                  n_bins: int = 360, changes: ModelChanges | None = None):
-        self.geometry = geom
         self.changes = ModelChanges() if changes is None else changes
+        self._plain_geometry = geom
+        self.geometry = with_flank_layer(geom, self.changes)
         self.material = Material(geom.E if E is None else E, geom.nu)
         self.n_bins = n_bins
         self.half = (mesh.symmetry == "half"
@@ -132,7 +140,7 @@ class LostMotionModel:
         if any(k == "tooth" for k, _ in pairs):
             raise RuntimeError("apply_tooth_stage_changes: the teeth are already engaged")
         old = self.changes
-        handled = {"flank_friction", "cs_rim_stiffness_N_mm2", "cs_scale"}
+        handled = {"flank_friction", "cs_rim_stiffness_N_mm2", "cs_scale", "flank_layer_m"}
         other = [f.name for f in fields(ModelChanges) if f.name not in handled
                  and getattr(changes, f.name) != getattr(ModelChanges(), f.name)]
         if other:    # a new tooth-stage change must be applied here too (adding-an-effect.md)
@@ -142,6 +150,7 @@ class LostMotionModel:
             self._switch_cs(changes, old)
         self.solver.friction = flank_law(changes.flank_friction, self.nwatch,
                                          self.solver.friction, len(pairs))
+        self.geometry = with_flank_layer(self._plain_geometry, changes)   # the tooth rows come after this
         self.changes = changes
 
     def _switch_cs(self, changes: ModelChanges, old: ModelChanges):

@@ -27,7 +27,7 @@ import numpy as np
 from hdwf.fe.contact_geometry import boundary_edge_normals, closest_segments
 from hdwf.fe.contact_rows import tooth_rows
 from hdwf.fe.model import LostMotionModel
-from hdwf.fe.relinearise import GEO_MAX_IT, GEO_TOL, held_back, settle
+from hdwf.fe.relinearise import GEO_MAX_IT, GEO_TOL, held_back, penetration, settle
 from hdwf.fe.solver import ContactFailure, LevelSolution
 
 RAMP_STEP_M = 0.05   # largest drop of the held-back overlap per ramp step, in modules
@@ -86,7 +86,7 @@ def mount_preloaded(model: LostMotionModel, level: LevelSolution) -> tuple[Level
     if overlap <= 0:     # no tooth overlaps: one solve with the tooth rows in (true gaps)
         level, err = _ramp_step(model, level, 0.0, GEO_TOL)
     check = tooth_rows(st, geom, level.u_watch, np.inf, nodes=nodes)
-    pen = max(0.0, float(-(check.g0 + check.G @ level.u_watch).min()))
+    pen = max(0.0, penetration(model, level, check))
     if pen > GEO_TOL + model.solver.settings.tol_gap:
         raise ContactFailure(f"preload ramp: {pen * 1000:.3f} um penetration re-detected at the "
                              "mounted state")

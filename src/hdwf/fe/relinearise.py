@@ -113,6 +113,30 @@ def _redetect(model: LostMotionModel, u: np.ndarray, hold: float) -> tuple[Rows,
     return tooth, cam, err
 
 
+def layer_approach(model: LostMotionModel, level: LevelSolution, check: Rows) -> np.ndarray:
+    """The flank layer's approach s p (mm) at each row of ``check`` (tooth rows re-detected at
+    ``level``), from the forces of the model's tooth rows on the same slave nodes; zeros
+    without a layer.  A re-detected overlap up to this is the layer's, not a penetration."""
+    rows = model.rows["tooth"]
+    if rows.compliance is None:
+        return np.zeros(check.G.shape[0])
+    force = np.zeros(rows.G.shape[0])
+    for (kind, i), p in zip(level.pair_ids, level.normal_force):
+        if kind == "tooth":
+            force[i] = p
+    fs_nodes, cs_nodes = rows.slave_nodes
+    key = {("fs", n): a for n, a in zip(fs_nodes.tolist(), (rows.compliance * force)[:fs_nodes.size])}
+    key.update({("cs", n): a for n, a in zip(cs_nodes.tolist(), (rows.compliance * force)[fs_nodes.size:])})
+    cf, cc = check.slave_nodes
+    return np.array([key.get(("fs", n), 0.0) for n in cf.tolist()] + [key.get(("cs", n), 0.0) for n in cc.tolist()])
+
+
+def penetration(model: LostMotionModel, level: LevelSolution, check: Rows) -> float:
+    """Largest penetration (mm) of the re-detected rows ``check`` at ``level``, the layer's
+    approach allowed."""
+    return float(-(check.g0 + check.G @ level.u_watch + layer_approach(model, level, check)).min())
+
+
 def settle_teeth(model: LostMotionModel, torque: float,
                  level: LevelSolution) -> tuple[LevelSolution, float]:
     """At +-T (preloaded teeth): the tooth and cam rows settled at the deformed state (re-detected and
@@ -128,7 +152,7 @@ def settle_teeth(model: LostMotionModel, torque: float,
                              f"{err * 1000:.3f} um off their linearisation after "
                              f"{GEO_MAX_IT} re-linearisations")
     chk = tooth_rows(model.structure, model.geometry, level.u_watch, np.inf)
-    return level, float(-(chk.g0 + chk.G @ level.u_watch).min())
+    return level, penetration(model, level, chk)
 
 
 def redetect_teeth(model: LostMotionModel, torque: float,
@@ -142,7 +166,7 @@ def redetect_teeth(model: LostMotionModel, torque: float,
     geom = model.geometry
     for relin in range(4):
         chk = tooth_rows(model.structure, geom, level.u_watch, np.inf)
-        pen_nl = float(-(chk.g0 + chk.G @ level.u_watch).min())
+        pen_nl = penetration(model, level, chk)
         if pen_nl <= GEO_TOL or relin == 3:
             break
         tr = model.rows["tooth"]

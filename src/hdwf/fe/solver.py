@@ -94,6 +94,7 @@ class _LevelProblem:
     mode_names: list[ModeName]
     mode_gap_rates: np.ndarray    # GR = G R
     ball_index: np.ndarray        # positions of the ball pairs in ``ids``
+    row_compliance: np.ndarray    # constant compliance in series with each pair (flank layer)
     u_start: np.ndarray           # last level's displacement (or the free torque response)
     free_gap: np.ndarray          # g0 + G u_start
 
@@ -191,6 +192,7 @@ class ContactSolver:
             id_position={i: j for j, i in enumerate(ids)}, modes=rigid, mode_names=modes,
             mode_gap_rates=G @ rigid.watch,
             ball_index=np.array([j for j, (k, _) in enumerate(ids) if k == "ball"]),
+            row_compliance=stacked.compliance,
             u_start=u0, free_gap=g0 + G @ u0)
 
     def _solution(self, problem: _LevelProblem, outcome: _ActiveSetOutcome, act: set[PairId],
@@ -238,7 +240,7 @@ class ContactSolver:
               level: Level) -> _ActiveSetOutcome:
         """Primal-dual active set on the dense dual problem; see the module docstring."""
         ids = problem.ids
-        sdiag = np.zeros(len(ids))
+        sdiag = problem.row_compliance.copy()
         sdiag[problem.ball_index] = s_ball
         Guq = problem.G @ problem.structure.unit_torque_u_watch
         A = set(act)
