@@ -20,6 +20,8 @@ Pearson correlation ours vs paper) and the paper's dPhi/dr_FS on the same design
 ``--deflection 1.4 --addendum-frac 0.38 --interference 0`` solves the other preload, a deeper
 cam (``DriveGeometry.deflection_coeff``; docs/fe-model.md, "A deeper cam instead");
 ``--offsets radial`` reads r_FS, r_CS as rack shifts (``DriveGeometry.offset_direction``).
+``--flank-layer 1167,2333`` solves each interference with a compliant flank layer of each
+thickness (modules; effect ``flank_layer``, docs/fe-model.md, "A compliant flank layer").
 """
 
 from __future__ import annotations
@@ -38,7 +40,7 @@ from scipy.stats import spearmanr
 
 from hdwf.drive.geometry import drive_geometry
 from hdwf.drive.mesh import build_mesh
-from hdwf.fe import ISO76_BALL_PRESSURE_MPA, solve_lost_motion
+from hdwf.fe import ISO76_BALL_PRESSURE_MPA, ModelChanges, solve_lost_motion
 from hdwf.fe.cycle import EXIT_ARC_DEG
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -56,7 +58,7 @@ def _sets(text: str) -> list[int]:
 
 def solve_all(unit: str, sets: list[int], interferences: list[float], zone90: bool, out: Path,
               tip_relief: float = 0.0, zone: float | None = None, mesh_size: tuple[int, int] = (5, 3),
-              shape: dict | None = None):
+              shape: dict | None = None, layers: tuple[float, ...] = (0.0,)):
     shape = shape or {}     # deflection_coeff / addendum_frac / offset_direction for drive_geometry
     table = pd.read_csv(ROOT / "data" / "paper" / TABLES[unit]).set_index("set")
     for s in sets:
@@ -66,15 +68,16 @@ def solve_all(unit: str, sets: list[int], interferences: list[float], zone90: bo
         eh, et = mesh_size
         mesh = build_mesh(g0, elements_over_height=eh, elements_over_thickness=et, symmetry="half")
         mesh_s = time.perf_counter() - t0
-        runs = [(i, zone) for i in interferences] + ([(0.0, 90.0)] if zone90 else [])
-        for im, zone_deg in runs:
+        runs = [(i, zone, lam) for i in interferences for lam in layers] + ([(0.0, 90.0, 0.0)] if zone90 else [])
+        for im, zone_deg, lam in runs:
             # interference is a flank offset of the FS teeth: a new outline, a new mesh
             g = drive_geometry(unit, *(row[c] for c in COLUMNS), interference_m=im,
                                tip_relief=tip_relief, **shape)
             m = mesh if im == 0 else build_mesh(g, elements_over_height=eh, elements_over_thickness=et,
                                                 symmetry="half")
-            r = solve_lost_motion(g, m, steps_per_ramp=5, zone_deg=zone_deg)
-            rec = {"unit": unit, "set": s, "interference_m": im, "tip_relief": tip_relief,
+            r = solve_lost_motion(g, m, steps_per_ramp=5, zone_deg=zone_deg,
+                                  changes=ModelChanges(flank_layer_m=lam))
+            rec = {"unit": unit, "set": s, "interference_m": im, "flank_layer_m": lam, "tip_relief": tip_relief,
                    "deflection_coeff": g.deflection_coeff, "addendum_frac": round(g.addendum / (
                        g.r_fs_tip - g.r_fs_root), 6), "offset_direction": g.offset_direction,
                    "mesh": f"{eh}x{et}",
@@ -86,7 +89,7 @@ def solve_all(unit: str, sets: list[int], interferences: list[float], zone90: bo
                    "notes": r.notes, "loaded_arc_deg": r.loaded_arc_deg,
                    "ball_load_max_N": r.max_ball_load_N, "ball_pressure_max_MPa": r.max_ball_pressure_MPa}
             append_rows(out, pd.DataFrame([rec]))
-            print(f"{unit} set {s:2d} κ={g.deflection_coeff:g} δ={im:.2f} m zone {rec['zone_deg']:.0f}: {r.status} "
+            print(f"{unit} set {s:2d} κ={g.deflection_coeff:g} δ={im:.2f} m layer {lam:g} m zone {rec['zone_deg']:.0f}: {r.status} "
                   f"Φ {r.lost_motion_arcmin:.4f} (paper {row['lost_motion_arcmin']:.4f}) "
                   f"solve {r.solve_s:.1f} s teeth {r.teeth_in_contact} out to {r.loaded_arc_deg:.1f}° "
                   f"ball {r.max_ball_load_N:.0f} N {r.max_ball_pressure_MPa:.0f} MPa {r.reason[:120]}", flush=True)
@@ -122,13 +125,15 @@ def summary(out: Path):
         df["deflection_coeff"], df["addendum_frac"] = 1.0, 0.45
     if "offset_direction" not in df:
         df["offset_direction"] = "normal"
+    if "flank_layer_m" not in df:
+        df["flank_layer_m"] = 0.0
     for (unit, rel, size, kappa, ha, od), du in df.groupby(["unit", "tip_relief", "mesh", "deflection_coeff",
                                                            "addendum_frac", "offset_direction"]):
         table = pd.read_csv(ROOT / "data" / "paper" / TABLES[unit]).set_index("set")
-        for (im, zone), d in du.groupby(["interference_m", "zone_deg"]):
+        for (im, lam, zone), d in du.groupby(["interference_m", "flank_layer_m", "zone_deg"]):
             ok = d[d.status == "ok"]
             a = agreement(table, ok)
-            print(f"{unit} mesh {size} {od} offsets relief {rel:g} κ={kappa:g} addendum {ha:.3g} h δ={im:.3f} m zone {zone:.0f}: {len(ok)}/{len(d)} ok, "
+            print(f"{unit} mesh {size} {od} offsets relief {rel:g} κ={kappa:g} addendum {ha:.3g} h δ={im:.3f} m layer {lam:g} m zone {zone:.0f}: {len(ok)}/{len(d)} ok, "
                   f"Φ {ok.phi.min():.3f}–{ok.phi.max():.3f}, median ratio ours/paper {a['ratio']:.3f}, "
                   f"Spearman {a['rho']:.3f}, R² {a['r2']:.3f}, "
                   f"dΦ/dr_FS {a['slope']:.4f} ({a['paper_slope']:.4f}) arcmin/µm, "
@@ -155,10 +160,12 @@ if __name__ == "__main__":
     ap.add_argument("--mesh", default="5x3",
                     help="elements over the tooth height x thickness (10x6 is the studies' default)")
     add_shape_arguments(ap)
+    ap.add_argument("--flank-layer", default="0",
+                    help="flank layer thicknesses (modules, comma separated; 0 = none)")
     ap.add_argument("--summary-only", action="store_true")
     a = ap.parse_args()
     if not a.summary_only:
         solve_all(a.unit, _sets(a.sets), [float(x) for x in a.interference.split(",")], a.zone90,
                   a.out, a.tip_relief, a.zone, tuple(int(n) for n in a.mesh.split("x")),
-                  shape_of(a))
+                  shape_of(a), tuple(float(x) for x in a.flank_layer.split(",")))
     summary(a.out)

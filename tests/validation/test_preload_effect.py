@@ -20,7 +20,7 @@ def test_preload_is_offered_by_name_only():
     """A design value: ``candidates: all`` leaves it out, a campaign that names it gets its grid."""
     assert "preload" not in candidate_names({}) and "thermal" in candidate_names({})
     plan = plan_variants({}, ["preload"])
-    assert plan[0] == {} and [v["preload"]["interference_m"] for v in plan[1:]] == pytest.approx([0.05, 0.1, 0.15, 0.2])
+    assert plan[0] == {} and [v["preload"]["interference_m"] for v in plan[1:]] == pytest.approx([0.05, 0.1, 0.15, 0.2, 0.25, 0.3])
 
 
 def test_a_reshaping_change_needs_its_geometry():

@@ -19,9 +19,9 @@ EFFECT = Effect(
         "campaign names it."),
     signature="the dead band shrinks and closes once the preload takes the clearance up; "
               "the elastic slopes stay",
-    parameters=(Parameter("interference_m", "m", 0.0, 0.2, 0.15,
+    parameters=(Parameter("interference_m", "m", 0.0, 0.3, 0.15,
                           "normal interference per FS flank, in units of the module m",
-                          "linear", 4),),
+                          "linear", 6),),
     apply=lambda ch, interference_m: replace(ch, flank_interference_m=interference_m),
     named_only=True,
     references="the paper's Tables 4/5 take up about 0.14-0.15 m of offset before play opens "
