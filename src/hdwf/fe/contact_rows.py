@@ -377,13 +377,13 @@ def tooth_rows(structure: Structure, geom: DriveGeometry, u_watch: np.ndarray, c
     fs_pass = _node_to_segment(fs, sn_fs, cs, "cs_teeth", u_watch, cand_gap)
     cs_pass = _node_to_segment(cs, sn_cs, fs, "fs_teeth", u_watch, cand_gap)
     sn_fs, sn_cs = sn_fs[fs_pass.kept], sn_cs[cs_pass.kept]
-    # which FS tooth a pair belongs to (teeth in contact); the half model's tooth z/2
-    # is the image of tooth 0 (ids modulo z/2; counted twice)
     compliance = None
     if geom.flank_layer_um_per_MPa > 0:
         compliance = 1e-3 * geom.flank_layer_um_per_MPa / np.concatenate(
             [geom.face_fs * _tributary_length(fs, "fs_teeth", sn_fs),
              geom.face_cs * _tributary_length(cs, "cs_teeth", sn_cs)])
+    # which FS tooth a pair belongs to (teeth in contact); the half model's tooth z/2
+    # is the image of tooth 0 (ids modulo z/2; counted twice)
     zid = geom.z_fs // 2 if structure.half else geom.z_fs
     th = np.concatenate([np.arctan2(fs.x[1, sn_fs], fs.x[0, sn_fs]),
                          np.arctan2(cs.x[1, sn_cs], cs.x[0, sn_cs])])
