@@ -3,8 +3,9 @@
 Run with one thread, e.g.  OMP_NUM_THREADS=1 python benchmarks/bench_solve.py
 Options: a positional refinement (default 1.0), ``--symmetry full|half`` (default full:
 the half model uses the drive's 180 deg point symmetry), ``--unit hd42|hd120`` (HD 120
-Table 5 set 8), ``--repeats N`` and ``--preload DELTA`` (the studies' preloaded engagement,
-``interference_m`` = DELTA with its tip relief, every tooth watched).
+Table 5 set 8), ``--repeats N``, ``--preload DELTA`` (a preloaded engagement alone,
+``interference_m`` = DELTA with its tip relief, every tooth watched) and ``--studies-model``
+(the effects of ``config.yaml``'s ``fe.effects``, the model of the ``fe`` and ``fe_at_paper`` studies).
 Prints mesh time, solve_s, factorize_s (one factorisation of every body's stiffness),
 their ratio, Phi and the peak resident memory of the process (resource.getrusage).
 """
@@ -19,10 +20,12 @@ import time
 
 import _one_thread  # noqa: F401,E402  (first: one BLAS thread, hdwf importable)
 
+from hdwf.config import load_config  # noqa: E402
 from hdwf.fe import solve_lost_motion  # noqa: E402
 from hdwf.drive.geometry import drive_geometry  # noqa: E402
 from hdwf.drive.mesh import build_mesh  # noqa: E402
 from hdwf.validation.effects import model_changes  # noqa: E402
+from _workspace import ROOT  # noqa: E402
 
 
 DESIGNS = {
@@ -34,12 +37,16 @@ DESIGNS = {
 
 
 def main(repeats: int = 3, refinement: float = 1.0, symmetry: str = "full",
-         unit: str = "hd42", preload: float = 0.0) -> None:
+         unit: str = "hd42", preload: float = 0.0, studies_model: bool = False) -> None:
     args, label = DESIGNS[unit]
-    changes = model_changes({"preload": {"interference_m": preload}} if preload > 0 else {})
+    if studies_model:
+        effects = load_config(ROOT / "config.yaml")["fe"]["effects"]
+        label += f", the studies' model {effects}"
+    else:
+        effects = {"preload": {"interference_m": preload}} if preload > 0 else {}
+        label += f", preload {preload:g} m" if preload > 0 else ""
+    changes = model_changes(effects)
     g = drive_geometry(*args, **changes.geometry_part())
-    if preload > 0:
-        label += f", preload {preload:g} m"
     t0 = time.perf_counter()
     mesh = build_mesh(g, refinement=refinement, symmetry=symmetry)
     mesh_s = time.perf_counter() - t0
@@ -73,6 +80,9 @@ if __name__ == "__main__":
     ap.add_argument("--symmetry", choices=("full", "half"), default="full")
     ap.add_argument("--unit", choices=tuple(DESIGNS), default="hd42")
     ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--preload", type=float, default=0.0, help="interference_m of the preload (0: bare)")
+    model = ap.add_mutually_exclusive_group()
+    model.add_argument("--preload", type=float, default=0.0, help="interference_m of the preload (0: bare)")
+    model.add_argument("--studies-model", action="store_true", help="config.yaml's fe.effects")
     a = ap.parse_args()
-    main(repeats=a.repeats, refinement=a.refinement, symmetry=a.symmetry, unit=a.unit, preload=a.preload)
+    main(repeats=a.repeats, refinement=a.refinement, symmetry=a.symmetry, unit=a.unit, preload=a.preload,
+         studies_model=a.studies_model)

@@ -57,11 +57,13 @@ class ColumnStore:
         """sum_k weights[k] * column[positions[k]] (nwatch)."""
         return weights @ self._rows[positions]
 
-    def project(self, G: sp.csr_matrix, n: int | None = None) -> np.ndarray:
-        """G @ columns[:, :n] (rows x n) for sparse rows G, reading only the watch entries G
-        touches (a contact row has a handful) instead of copying the whole store."""
+    def project(self, G: sp.csr_matrix, n: int | None = None, start: int = 0) -> np.ndarray:
+        """G @ columns[:, start:n] (rows x (n - start)) for sparse rows G, reading only the watch
+        entries G touches (a contact row has a handful) instead of copying the whole store."""
         n = self.size if n is None else n
         G = sp.csr_matrix(G)
-        touched = self._rows[:n][:, G.indices]               # n x nnz(G)
-        per_entry = sp.csr_matrix((G.data, np.arange(G.nnz), G.indptr), shape=(G.shape[0], G.nnz))
-        return np.asarray(per_entry @ np.ascontiguousarray(touched.T))
+        # each watch entry read once, though neighbouring rows share nodes
+        watched, entry = np.unique(G.indices, return_inverse=True)
+        touched = self._rows[start:n][:, watched]            # (n - start) x entries touched
+        compact = sp.csr_matrix((G.data, entry, G.indptr), shape=(G.shape[0], watched.size))
+        return np.asarray(compact @ np.ascontiguousarray(touched.T))

@@ -81,15 +81,11 @@ def frictionless_kkt(block: ActiveBlock) -> KktSystem:
 
 
 class FrictionlessLevel:
-    """One load level without friction: no tangential unknowns, nothing to settle."""
+    """One load level without friction: no tangential unknowns, nothing to settle (and no
+    tangential displacement: the solver forms u from the normal forces alone)."""
 
     def kkt(self, block: ActiveBlock) -> KktSystem:
         return frictionless_kkt(block)
-
-    def tangential(self, system: KktSystem, solution: np.ndarray, block: ActiveBlock,
-                   u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The displacement and tangential forces: ``u`` as it is, no forces."""
-        return u, np.zeros(block.n_pairs)
 
     def settle(self, normal_force: np.ndarray, tangential_force: np.ndarray,
                u: np.ndarray) -> bool:

@@ -12,7 +12,8 @@ is solved exactly by a primal-dual active-set (PDAS) iteration: solve the KKT sy
 the current active set, drop pairs with tensile p, add every candidate with penetration,
 repeat until no pair has p < 0 and the largest penetration of all candidate pairs is
 < ``tol_gap`` (1e-5 mm = 0.01 um).  Candidates outside the working set are checked every
-iteration with the displacement on the contact DOFs, so no violated pair can be missed.
+iteration with their gaps G u, so no violated pair can be missed; without friction G u comes
+from the working set's columns projected on the level's rows (``ProjectedColumns``).
 A free rigid mode that is loaded but not yet held (the FS rotation under torque while the
 teeth are apart) is closed by adding the first pair that closes along that mode.  A mode
 held only weakly (e.g. by two near-radial tip contacts of a relieved, lightly preloaded
@@ -38,7 +39,7 @@ from hdwf.fe.contact_rows import PairId, Rows, stack_rows
 from hdwf.fe.friction import (FRICTION_MAX_IT, ActiveBlock, FlankLaw, FrictionLevel,
                               FrictionlessLevel)
 from hdwf.fe.structure import ModeName, RigidModes, Structure
-from hdwf.fe.working_set import WorkingSet
+from hdwf.fe.working_set import ProjectedColumns, WorkingSet
 
 TOL_GAP = 1e-5          # mm: 0.01 um allowed penetration
 
@@ -97,6 +98,7 @@ class _LevelProblem:
     row_compliance: np.ndarray    # constant compliance in series with each pair (flank layer)
     u_start: np.ndarray           # last level's displacement (or the free torque response)
     free_gap: np.ndarray          # g0 + G u_start
+    projected: ProjectedColumns   # G K^-1 G_W^T, the gaps of a frictionless iterate
 
 
 @dataclass(frozen=True)
@@ -104,9 +106,11 @@ class _ActiveSetOutcome:
     p: np.ndarray
     ft: np.ndarray
     alpha: np.ndarray
-    u: np.ndarray
+    u: np.ndarray | None          # formed only for the Hertz loop's last outcome without friction
     gap: np.ndarray
     converged: bool
+    positions: np.ndarray         # working-set positions of the active pairs ...
+    p_active: np.ndarray          # ... and their forces (what u is formed from)
 
 
 @dataclass
@@ -123,10 +127,12 @@ class ContactSolver:
     iterations: int = 0
     last_u: np.ndarray | None = None
     ball_loads: np.ndarray | None = None
+    projected: ProjectedColumns | None = None   # of the last level, kept while its rows stay
 
     def copy(self) -> "ContactSolver":
         """An independent copy of the state (working set and friction cache copied)."""
-        return replace(self, working_set=self.working_set.copy(), friction=self.friction.copy())
+        return replace(self, working_set=self.working_set.copy(), friction=self.friction.copy(),
+                       projected=None)
 
     def enter(self, structure: Structure, rows: dict[str, Rows], ids: list[PairId]):
         """Enter pairs into the working set (and the friction cache)."""
@@ -187,13 +193,15 @@ class ContactSolver:
         G, g0, ids = stacked.G, stacked.g0, stacked.ids
         rigid = structure.rigid_modes(modes)
         u0 = torque * structure.unit_torque_u_watch if self.last_u is None else self.last_u
+        if self.projected is None or not _same_rows(self.projected.G, G):
+            self.projected = ProjectedColumns(G)
         return _LevelProblem(
             structure=structure, rows=rows, torque=torque, G=G, g0=g0, ids=ids,
             id_position={i: j for j, i in enumerate(ids)}, modes=rigid, mode_names=modes,
             mode_gap_rates=G @ rigid.watch,
             ball_index=np.array([j for j, (k, _) in enumerate(ids) if k == "ball"]),
             row_compliance=stacked.compliance,
-            u_start=u0, free_gap=g0 + G @ u0)
+            u_start=u0, free_gap=g0 + G @ u0, projected=self.projected)
 
     def _solution(self, problem: _LevelProblem, outcome: _ActiveSetOutcome, act: set[PairId],
                   level: Level) -> LevelSolution:
@@ -233,6 +241,10 @@ class ContactSolver:
         else:
             raise ContactFailure("Hertz secant iteration on ball loads did not converge")
         self.ball_loads = pb
+        if outcome.u is None:
+            u = (problem.torque * problem.structure.unit_torque_u_watch + problem.modes.watch @ outcome.alpha
+                 + self.working_set.store.combine(outcome.positions, outcome.p_active))
+            outcome = replace(outcome, u=u)
         return outcome, act
 
     # ---------------------------------------------------------------- PDAS
@@ -252,8 +264,8 @@ class ContactSolver:
             self.enter(problem.structure, problem.rows, sorted(A - set(self.working_set.position)))
             self._hold_loaded_modes(problem, A)
             block = self._active_block(problem, A, sdiag, Guq)
-            pA, p_full, ft_full, alpha, u = self._solve_block(problem, block, level)
-            gap = problem.g0 + problem.G @ u + sdiag * p_full
+            pA, p_full, ft_full, alpha, u, Gu = self._solve_block(problem, block, level, Guq)
+            gap = problem.g0 + Gu + sdiag * p_full
             neg = [block.pairs[k] for k in np.flatnonzero(pA < 0)]
             viol = np.flatnonzero(gap < -self.settings.tol_gap)
             viol = viol[np.argsort(gap[viol])]
@@ -262,7 +274,8 @@ class ContactSolver:
             # a near-mechanism makes one iterate overshoot)
             viol = viol[:max(self.settings.add_min, int(self.settings.add_frac * len(viol)))]
             if not neg and not viol:
-                return _ActiveSetOutcome(np.maximum(p_full, 0.0), ft_full, alpha, u, gap, True)
+                return _ActiveSetOutcome(np.maximum(p_full, 0.0), ft_full, alpha, u, gap, True,
+                                         block.positions, pA)
             if loaded:
                 cut = self._cut_back(problem, gap_at, gap)
                 if cut is not None:      # overshoot: step to the first closing pair(s)
@@ -273,7 +286,7 @@ class ContactSolver:
                 neg = [block.pairs[int(np.argmin(pA))]]
             A.difference_update(neg)
             A.update(viol)
-        return _ActiveSetOutcome(p_full, ft_full, alpha, u, gap, False)
+        return _ActiveSetOutcome(p_full, ft_full, alpha, u, gap, False, block.positions, pA)
 
     def _cut_back(self, problem: _LevelProblem, gap_at: np.ndarray,
                   gap: np.ndarray) -> tuple[np.ndarray, list[PairId]] | None:
@@ -334,8 +347,12 @@ class ContactSolver:
             gap_rhs=-(problem.g0[rows] + T * Guq[rows]), mode_rhs=-T * problem.modes.load,
             n_pairs=len(problem.ids))
 
-    def _solve_block(self, problem: _LevelProblem, block: ActiveBlock, level: Level):
-        """Solve the KKT system of an active set: (p_A, p, f_t, alpha, u_watch)."""
+    def _solve_block(self, problem: _LevelProblem, block: ActiveBlock, level: Level, Guq: np.ndarray):
+        """Solve the KKT system of an active set: (p_A, p, f_t, alpha, u_watch, G u).
+
+        Without friction u is not formed (None): G u comes from the projected columns, and
+        the Hertz loop forms u once from its last outcome.  With friction the tangential
+        forces add their own columns to u, so u is formed and G applied to it."""
         system = level.kkt(block)
         nA, nS, nm = len(block.pairs), system.n_tangential, block.mode_rows.shape[1]
         M = system.matrix
@@ -345,9 +362,19 @@ class ContactSolver:
         except np.linalg.LinAlgError:
             sol = np.linalg.lstsq(M, system.rhs, rcond=None)[0]
         pA, alpha = sol[:nA], sol[nA + nS:]
+        p_full = np.zeros(block.n_pairs)
+        p_full[block.rows] = pA
+        if isinstance(level, FrictionlessLevel):
+            Gu = (problem.torque * Guq + problem.projected.combine(self.working_set, block.positions, pA)
+                  + problem.mode_gap_rates @ alpha)
+            return pA, p_full, np.zeros(block.n_pairs), alpha, None, Gu
         u = (problem.torque * problem.structure.unit_torque_u_watch
              + self.working_set.store.combine(block.positions, pA) + problem.modes.watch @ alpha)
         u, ft_full = level.tangential(system, sol, block, u)
-        p_full = np.zeros(block.n_pairs)
-        p_full[block.rows] = pA
-        return pA, p_full, ft_full, alpha, u
+        return pA, p_full, ft_full, alpha, u, problem.G @ u
+
+
+def _same_rows(A: sp.csr_matrix, B: sp.csr_matrix) -> bool:
+    """Whether two stacked row operators are the same numbers (so are their projections)."""
+    return (A.shape == B.shape and A.nnz == B.nnz and np.array_equal(A.indptr, B.indptr)
+            and np.array_equal(A.indices, B.indices) and np.array_equal(A.data, B.data))
