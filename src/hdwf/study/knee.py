@@ -196,6 +196,13 @@ def _rho(a: np.ndarray, b: np.ndarray) -> float:
     return float(spearmanr(a, b)[0]) if len(a) >= 3 else float("nan")
 
 
+def _pearson_rows(x: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """Pearson's r of ``x`` with each row of ``rows`` (Spearman's rho when both are ranks)."""
+    xc = x - x.mean()
+    rc = rows - rows.mean(axis=1, keepdims=True)
+    return (rc @ xc) / (np.linalg.norm(rc, axis=1) * np.linalg.norm(xc))
+
+
 def floor_ranks(reference: pd.DataFrame, model_arcmin: np.ndarray, nominal: Mapping[str, float], *,
                 threshold: float = 0.9, draws: int = 2000, seed: int = 0,
                 column: str = "lost_motion_arcmin") -> FloorRanks:
@@ -227,8 +234,9 @@ def floor_ranks(reference: pd.DataFrame, model_arcmin: np.ndarray, nominal: Mapp
     table, model = reference[keep].reset_index(drop=True), model[keep]
     fit = fit_hinge(table, nominal, column)
     y = table[column].to_numpy(float)
-    flat = fit.clearance_um(table, nominal) < fit.knee_um
-    hinge = fit.predict(fit.clearance_um(table, nominal))
+    s = fit.clearance_um(table, nominal)
+    flat = s < fit.knee_um
+    hinge = fit.predict(s)
 
     floor = table[flat]
     coefficients, r2, p = (float("nan"),) * len(PARAMETER_COLUMNS), float("nan"), float("nan")
@@ -243,7 +251,7 @@ def floor_ranks(reference: pd.DataFrame, model_arcmin: np.ndarray, nominal: Mapp
     ordered = np.tile(hinge, (draws, 1))
     # the flat designs keep their common value, in a random order far finer than any step of the hinge
     ordered[:, flat] += 1e-9 * rng.permuted(np.tile(np.arange(flat.sum()), (draws, 1)), axis=1)
-    rhos = np.corrcoef(rankdata(y), rankdata(ordered, axis=1))[0, 1:]
+    rhos = _pearson_rows(rankdata(y), rankdata(ordered, axis=1))
     return FloorRanks(n=len(table), n_floor=int(flat.sum()), floor_coefficients=coefficients, floor_r2=r2, floor_p=p,
                       spearman_hinge=_rho(y, hinge), spearman_ceiling=float(rhos.mean()),
                       share_at_least=float(np.mean(rhos >= threshold)),
