@@ -132,7 +132,7 @@ class ContactSolver:
     def copy(self) -> "ContactSolver":
         """An independent copy of the state (working set and friction cache copied)."""
         return replace(self, working_set=self.working_set.copy(), friction=self.friction.copy(),
-                       projected=None)
+                       projected=None if self.projected is None else self.projected.copy())
 
     def enter(self, structure: Structure, rows: dict[str, Rows], ids: list[PairId]):
         """Enter pairs into the working set (and the friction cache)."""

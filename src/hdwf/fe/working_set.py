@@ -135,11 +135,17 @@ class ProjectedColumns:
         self.store = ColumnStore(G.shape[0])
         self.generation = -1
 
+    def copy(self) -> "ProjectedColumns":
+        """An independent copy (for a copied working set: same columns, same generation)."""
+        new = ProjectedColumns(self.G)
+        new.store, new.generation = self.store.copy(), self.generation
+        return new
+
     def combine(self, working_set: WorkingSet, positions: np.ndarray,
                 weights: np.ndarray) -> np.ndarray:
         """G sum_k weights[k] x[positions[k]] (rows long), the working set's new columns
         projected first."""
-        if self.generation != working_set.generation:
+        if self.generation != working_set.generation or working_set.store.size < self.store.size:
             self.store, self.generation = ColumnStore(self.G.shape[0]), working_set.generation
         n0 = self.store.size
         if working_set.store.size > n0:
