@@ -67,9 +67,8 @@ def test_projected_columns_give_the_gaps_of_the_displacement_as_the_set_grows_an
 @pytest.mark.slow
 def test_solver_gaps_are_those_of_its_displacement_and_a_fork_solves_alike():
     """On a preloaded coarse HD 42 section at the test torque (every tooth pair a candidate,
-    the FS rotation a free mode): the gaps a level
-    returns equal g0 + G u + s p of the displacement it returns (the iterate never forms u,
-    the level's result does), to 1e-9 mm; the projection is kept from one level to the next
+    the FS rotation a free mode): the gaps a level returns equal g0 + G u + s p of the
+    displacement it returns (the iterate never forms u, the level's result does), to 1e-9 mm; the projection is kept from one level to the next
     on the same rows; a fork (copied projection) solves the next level to the same forces as
     the model it was forked from (the same state, so the same iterates)."""
     from hdwf.drive.geometry import drive_geometry

@@ -242,9 +242,8 @@ class ContactSolver:
             raise ContactFailure("Hertz secant iteration on ball loads did not converge")
         self.ball_loads = pb
         if outcome.u is None:
-            u = (problem.torque * problem.structure.unit_torque_u_watch + problem.modes.watch @ outcome.alpha
-                 + self.working_set.store.combine(outcome.positions, outcome.p_active))
-            outcome = replace(outcome, u=u)
+            outcome = replace(outcome, u=self._displacement(problem, outcome.positions, outcome.p_active,
+                                                            outcome.alpha))
         return outcome, act
 
     # ---------------------------------------------------------------- PDAS
@@ -368,10 +367,15 @@ class ContactSolver:
             Gu = (problem.torque * Guq + problem.projected.combine(self.working_set, block.positions, pA)
                   + problem.mode_gap_rates @ alpha)
             return pA, p_full, np.zeros(block.n_pairs), alpha, None, Gu
-        u = (problem.torque * problem.structure.unit_torque_u_watch
-             + self.working_set.store.combine(block.positions, pA) + problem.modes.watch @ alpha)
+        u = self._displacement(problem, block.positions, pA, alpha)
         u, ft_full = level.tangential(system, sol, block, u)
         return pA, p_full, ft_full, alpha, u, problem.G @ u
+
+    def _displacement(self, problem: _LevelProblem, positions: np.ndarray, p_active: np.ndarray,
+                      alpha: np.ndarray) -> np.ndarray:
+        """u on the watch dofs from the torque, the active pairs' forces and the modes."""
+        return (problem.torque * problem.structure.unit_torque_u_watch
+                + self.working_set.store.combine(positions, p_active) + problem.modes.watch @ alpha)
 
 
 def _same_rows(A: sp.csr_matrix, B: sp.csr_matrix) -> bool:
