@@ -36,7 +36,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import splu
+from cholespy import CholeskySolverD, MatrixType
 from skfem import Basis, ElementTriP1, ElementVector, MeshTri, asm
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
@@ -48,15 +48,33 @@ from hdwf.fe.changes import ModelChanges
 # Elasticity
 # --------------------------------------------------------------------------------------
 
-def factorize_spd(K: sp.spmatrix):
-    """LU of a symmetric positive definite stiffness (pinned dofs removed) by SuperLU.
+class SparseCholesky:
+    """K^-1 of a symmetric positive definite stiffness by CHOLMOD's sparse Cholesky factor.
 
-    Minimum degree on K + K^T with the diagonal as pivots (SuperLU's symmetric mode) keeps the
-    factors a third smaller than the default column ordering, and every back-substitution of a
-    compliance column that much faster; no pivoting is needed for a positive definite K.
+    Through ``cholespy`` (its CPU solver is CHOLMOD with a fill-reducing ordering): a body's
+    compliance columns are back-substituted some hundred times per design, and a Cholesky
+    factor solves a block of them 2-3 times faster than SuperLU's LU of the same matrix
+    (``benchmarks/bench_factor.py``). A K that is not positive definite (a floating body left
+    unpinned, a negative stiffness) raises ``ValueError`` here, at the factorisation.
     """
-    return splu(sp.csc_matrix(K), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                options={"SymmetricMode": True})
+
+    def __init__(self, K: sp.spmatrix):
+        K = sp.csr_matrix(K, dtype=np.float64)
+        self.shape = K.shape
+        self._solver = CholeskySolverD(K.shape[0], K.indptr.astype(np.int32), K.indices.astype(np.int32),
+                                       K.data, MatrixType.CSR)
+
+    def solve(self, F: np.ndarray) -> np.ndarray:
+        """K^-1 F for a vector or a block of columns (n x k)."""
+        B = np.ascontiguousarray(F, dtype=np.float64)
+        X = np.empty_like(B)
+        self._solver.solve(B, X)
+        return X
+
+
+def factorize_spd(K: sp.spmatrix) -> SparseCholesky:
+    """Factorise a symmetric positive definite stiffness (pinned dofs removed): ``SparseCholesky``."""
+    return SparseCholesky(K)
 
 
 def plane_stress_lame(E: float, nu: float) -> tuple[float, float]:
@@ -182,7 +200,7 @@ class Body:
     stiffness: sp.csr_matrix
     dofs: np.ndarray                   # (2, nnodes) dof numbers of every node
     free_dofs: np.ndarray              # unpinned dofs (reduced dofs in the half model)
-    factor: object                     # SuperLU of the stiffness on the free dofs
+    factor: SparseCholesky             # Cholesky factor of the stiffness on the free dofs
     modes: dict[str, np.ndarray]       # name -> full-body rigid mode vector
     watch_nodes: np.ndarray            # node ids whose dofs are watched
     watch_offset: int = 0              # offset of this body in the watch vector
@@ -200,10 +218,10 @@ class Body:
         if self.tie is not None:             # half model: solve on the tied (reduced) dofs
             Fr = np.asarray(self.tie.T @ F)
             Ur = np.zeros((self.tie.shape[1], F.shape[1]))
-            Ur[self.free_dofs] = self.factor.solve(np.asfortranarray(Fr[self.free_dofs]))
+            Ur[self.free_dofs] = self.factor.solve(Fr[self.free_dofs])
             return np.asarray(self.tie @ Ur)
         U = np.zeros((self.stiffness.shape[0], F.shape[1]))
-        U[self.free_dofs] = self.factor.solve(np.asfortranarray(F[self.free_dofs]))
+        U[self.free_dofs] = self.factor.solve(F[self.free_dofs])
         return U
 
     def node_displacements(self, nodes: np.ndarray, u_watch: np.ndarray) -> np.ndarray:
@@ -387,10 +405,10 @@ def make_body(name: str, bm: BodyMesh, material: Material, watch_nodes, *, fixed
         fixed, modes = _floating_supports(bm, nd, ndof, P)
     free = np.setdiff1d(np.arange(Kr.shape[0]), fixed)   # reduced dofs in the half model
     t0 = time.perf_counter()
-    lu = factorize_spd(Kr[free][:, free])
+    factor = factorize_spd(Kr[free][:, free])
     tf = time.perf_counter() - t0
     wn = np.unique(np.asarray(watch_nodes, dtype=np.int64))
-    return Body(name, bm, K, nd, free, lu, modes, wn, tie=P, tied_nodes=dep), tf
+    return Body(name, bm, K, nd, free, factor, modes, wn, tie=P, tied_nodes=dep), tf
 
 
 def make_cs_body(mesh0: BodyMesh, watch_nodes: np.ndarray, material: Material, half: bool,

@@ -55,6 +55,10 @@ class ColumnStore:
 
     def combine(self, positions: np.ndarray, weights: np.ndarray) -> np.ndarray:
         """sum_k weights[k] * column[positions[k]] (nwatch)."""
+        if 3 * len(positions) >= self.size:
+            # most of the store (a loaded preload holds ~70 % of its working set active): one
+            # pass over it with zero weights elsewhere is twice as fast as gathering the rows
+            return np.bincount(positions, weights, minlength=self.size) @ self._rows[:self.size]
         return weights @ self._rows[positions]
 
     def project(self, G: sp.csr_matrix, n: int | None = None, start: int = 0) -> np.ndarray:

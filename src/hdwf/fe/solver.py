@@ -1,6 +1,6 @@
 """The contact solver (hand-written): a dual Schur-complement / active-set method.
 
-Each body is factorised ONCE (scipy SuperLU, ``bodies``).  For a contact pair i the
+Each body is factorised ONCE (CHOLMOD sparse Cholesky, ``bodies``).  For a contact pair i the
 compliance column x_i = K^-1 G_i^T is obtained by back-substitution only when the pair
 first enters the working set, and reused over all later iterations and load steps
 (``working_set``).  On the working set the small dense mixed LCP
@@ -34,6 +34,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.linalg import cho_factor, cho_solve
 
 from hdwf.fe.contact_rows import PairId, Rows, stack_rows
 from hdwf.fe.friction import (FRICTION_MAX_IT, ActiveBlock, FlankLaw, FrictionLevel,
@@ -356,10 +357,7 @@ class ContactSolver:
         nA, nS, nm = len(block.pairs), system.n_tangential, block.mode_rows.shape[1]
         M = system.matrix
         M[nA + nS:, nA + nS:] = -1e-14 * np.eye(nm)   # keeps unheld, unloaded modes at zero
-        try:
-            sol = np.linalg.solve(M, system.rhs)
-        except np.linalg.LinAlgError:
-            sol = np.linalg.lstsq(M, system.rhs, rcond=None)[0]
+        sol = _solve_kkt(M, system.rhs, nA if isinstance(level, FrictionlessLevel) else None)
         pA, alpha = sol[:nA], sol[nA + nS:]
         p_full = np.zeros(block.n_pairs)
         p_full[block.rows] = pA
@@ -376,6 +374,35 @@ class ContactSolver:
         """u on the watch dofs from the torque, the active pairs' forces and the modes."""
         return (problem.torque * problem.structure.unit_torque_u_watch
                 + self.working_set.store.combine(positions, p_active) + problem.modes.watch @ alpha)
+
+
+def _solve_kkt(M: np.ndarray, rhs: np.ndarray, n_forces: int | None) -> np.ndarray:
+    """M^-1 rhs. A frictionless KKT matrix [[C, H], [H^T, E]] (``n_forces`` rows of C) is solved
+    through the Cholesky factor of its positive definite C and the small Schur complement of
+    the modes, half the work of an LU of M; anything else (friction, a C that is not positive
+    definite) by LU, and a singular M (an unheld mode) by least squares."""
+    if n_forces is not None:
+        try:
+            return _solve_saddle(M, rhs, n_forces)
+        except np.linalg.LinAlgError:
+            pass
+    try:
+        return np.linalg.solve(M, rhs)
+    except np.linalg.LinAlgError:
+        return np.linalg.lstsq(M, rhs, rcond=None)[0]
+
+
+def _solve_saddle(M: np.ndarray, rhs: np.ndarray, n: int) -> np.ndarray:
+    """[[C, H], [H^T, E]] [p; alpha] = [r; s]: p = C^-1 (r - H alpha), (H^T C^-1 H - E) alpha =
+    H^T C^-1 r - s. Raises ``LinAlgError`` when C is not positive definite."""
+    C, H, E = M[:n, :n], M[:n, n:], M[n:, n:]
+    factor = cho_factor(C, check_finite=False)
+    Ci_r = cho_solve(factor, rhs[:n], check_finite=False)
+    if H.shape[1] == 0:
+        return Ci_r
+    Ci_H = cho_solve(factor, H, check_finite=False)
+    alpha = np.linalg.solve(H.T @ Ci_H - E, H.T @ Ci_r - rhs[n:])
+    return np.concatenate([Ci_r - Ci_H @ alpha, alpha])
 
 
 def _same_rows(A: sp.csr_matrix, B: sp.csr_matrix) -> bool:

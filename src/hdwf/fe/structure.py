@@ -28,8 +28,9 @@ from hdwf.fe.node_columns import PATTERN_BODIES, NodeColumns
 
 ModeName = tuple[str, str]      # (body, mode), e.g. ("fs", "rot")
 
-# Columns per back-substitution: SuperLU's multi-column solve is fastest per column when the
-# block stays in cache (FS of HD 42, default half mesh: 2.7 ms a column at 16, 4.4 ms at 256)
+# Columns per back-substitution: a multi-column Cholesky solve is fastest per column when the
+# block stays in cache (FS of HD 42, default half mesh: 4.5 ms for one column, 2.0 ms a column at 8
+# and 16, 2.3 at 64; benchmarks/bench_factor.py)
 SOLVE_BATCH = 16
 
 
