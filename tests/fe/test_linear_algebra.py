@@ -26,6 +26,8 @@ def test_cholesky_factor_solves_vectors_and_blocks_as_a_dense_solve():
     # a single column, and a Fortran-ordered block (what sparse products hand over)
     assert np.allclose(factor.solve(F[:, 2]), exact[:, 2], rtol=0, atol=1e-10 * np.abs(exact).max())
     assert np.allclose(factor.solve(np.asfortranarray(F)), exact, rtol=0, atol=1e-10 * np.abs(exact).max())
+    # no columns at all (an empty set of rows): an empty answer, not a crash of the library
+    assert factor.solve(F[:, :0]).shape == (K.shape[0], 0)
 
 
 def test_cholesky_factor_refuses_a_matrix_that_is_not_positive_definite():

@@ -67,6 +67,8 @@ class SparseCholesky:
     def solve(self, F: np.ndarray) -> np.ndarray:
         """K^-1 F for a vector or a block of columns (n x k)."""
         B = np.ascontiguousarray(F, dtype=np.float64)
+        if B.size == 0:      # no columns: cholespy would crash on an empty block
+            return np.zeros(B.shape)
         X = np.empty_like(B)
         self._solver.solve(B, X)
         return X
