@@ -23,7 +23,7 @@ def test_cholesky_factor_solves_vectors_and_blocks_as_a_dense_solve():
     factor = factorize_spd(K)
     exact = np.linalg.solve(K.toarray(), F)
     assert np.allclose(factor.solve(F), exact, rtol=0, atol=1e-10 * np.abs(exact).max())
-    # a single column, and a Fortran-ordered block (what sparse products hand over)
+    # a single column, and a Fortran-ordered block (copied to the C order cholespy takes)
     assert np.allclose(factor.solve(F[:, 2]), exact[:, 2], rtol=0, atol=1e-10 * np.abs(exact).max())
     assert np.allclose(factor.solve(np.asfortranarray(F)), exact, rtol=0, atol=1e-10 * np.abs(exact).max())
     # no columns at all (an empty set of rows): an empty answer, not a crash of the library
@@ -46,6 +46,10 @@ def test_cholesky_factor_of_a_plane_stress_bar_gives_its_analytic_stretch():
     f[-1] = P
     u = factorize_spd(K).solve(f)
     assert u[-1] == pytest.approx(P * L / (E * A), rel=1e-12)
+
+
+def test_plane_stress_shear_modulus_is_e_over_two_one_plus_nu():
+    E = 210000.0
     assert plane_stress_lame(E, 0.3)[1] == pytest.approx(E / 2.6)
 
 

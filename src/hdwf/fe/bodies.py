@@ -60,7 +60,6 @@ class SparseCholesky:
 
     def __init__(self, K: sp.spmatrix):
         K = sp.csr_matrix(K, dtype=np.float64)
-        self.shape = K.shape
         self._solver = CholeskySolverD(K.shape[0], K.indptr.astype(np.int32), K.indices.astype(np.int32),
                                        K.data, MatrixType.CSR)
 
