@@ -197,16 +197,36 @@ def test_preloaded_variants_share_a_mount_only_across_series_elements():
 def test_preloaded_twist_is_settled_at_plus_and_minus_torque():
     """A preloaded section without play (hd42-lhs-09 of the default study, 0.147 m, relief
     1.1, the studies' mesh and 5 steps per ramp) is mirror-symmetric, so phi = phi' up to mesh
-    asymmetry, and the curve comes back to its start after +T.  With the tooth rows
+    asymmetry, and its Phi does not depend on the load path.  With the tooth rows
     re-linearised once at +T and kept, phi was 0.182 and phi' 0.055 arcmin and the curve came
-    back to 0.040 (docs/fe-model.md, "Gaps at +-T"); settled: 0.178, 0.179 and below 0.001."""
+    back to 0.040 (docs/fe-model.md, "Gaps at +-T"); settled: 0.178 and 0.179."""
     g = drive_geometry("hd42", 31.0021891, 41.9841730, 0.0095806475, 0.0038795075, 0.0105284616,
                        interference_m=0.147, tip_relief=1.1)
-    r = solve_lost_motion(g, build_mesh(g, 10, 6, symmetry="half"), steps_per_ramp=5)
+    mesh = build_mesh(g, 10, 6, symmetry="half")
+    r = solve_lost_motion(g, mesh, steps_per_ramp=5)
     assert r.status == "ok", r.reason
     assert r.phi_plus_arcmin == pytest.approx(r.phi_minus_arcmin, rel=0.03)
-    back_at_zero = r.twist_arcmin[np.flatnonzero(r.torque_Nm == 0)[1]]
-    assert abs(back_at_zero) < 0.02 * r.lost_motion_arcmin
+    # frictionless, Phi does not depend on the load path: one step per ramp (other warm starts,
+    # other iterates) settles at the same states within the 0.01 um gap tolerance
+    # (2 x 0.01 um over the CS base radius, 21 mm: 0.0033 arcmin)
+    one = solve_lost_motion(g, mesh, steps_per_ramp=1)
+    assert one.status == "ok", one.reason
+    assert one.lost_motion_arcmin == pytest.approx(r.lost_motion_arcmin, abs=0.0033)
+
+
+def test_frictionless_way_back_passes_through_the_way_up():
+    """Frictionless, a level on the way back is the problem of the way up at that torque (the
+    mount's rows, the same load: elastic contact without friction has one solution), so it is
+    not solved again and the curve comes back through the same points; solved again from
+    another warm start it would differ within the gap tolerance (0.4967 against 0.4971 arcmin
+    at 0.8 T on Table 4 set 8).  With flank friction nothing is reused, but a preloaded
+    section with friction does not solve today (docs/fe-model.md, Known limits)."""
+    g = drive_geometry(*NOMINAL, interference_m=0.05)
+    r = solve_lost_motion(g, build_mesh(g, **COARSE, symmetry="half"), steps_per_ramp=2)
+    assert r.status == "ok", r.reason
+    tw = r.twist_arcmin                      # 0, T/2, T, T/2, 0, -T/2, -T, -T/2, 0
+    assert tw[3] == tw[1] and tw[4] == tw[0] and tw[7] == tw[5]
+    assert tw[8] != tw[0]                    # -0 is its own level (the bias towards -T)
 
 
 def test_a_deeper_cam_is_sized_to_push_kappa_w0():

@@ -12,7 +12,9 @@ contact agrees with its linearisation within 0.05 um (``relinearise.settle``; th
 flanks along each other must not leave the gaps of the mounted state, or Phi depends on
 the load path and the mesh), then every tooth pair is re-paired from scratch as an
 independent check (``max_penetration_redetected_um``).  The way back starts from the mount's
-rows again: rows settled at +T fit that state only.  Without preload (and in the coning
+rows again: rows settled at +T fit that state only.  Frictionless, a level on the way back
+is then the same problem as the level at that torque on the way up (same rows, same load;
+elastic contact without friction has one solution), so it is not solved again.  Without preload (and in the coning
 slices) the near pairs are re-linearised once at +-T if more than 0.05 um penetration is
 re-detected, and those rows are kept for the way back (``redetect_teeth``).
 
@@ -258,13 +260,21 @@ def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWave
     active = mounted.solution.active
     twists, maxpen, maxpen_nl, tooth_count, arc = [], 0.0, 0.0, 0, float("nan")
     last_sign = 1.0
+    # frictionless with preloaded teeth, every level is solved with the mount's rows: the way
+    # back poses the same problem as the way up at the same torque, so its solution is reused
+    solved = {} if (geom.preloaded and model.changes.flank_friction == 0.0) else None
     for fraction in frac:
         if abs(fraction) > 1e-12:
             last_sign = math.copysign(1.0, fraction)
             T = fraction * Tn
         else:
             T = ZERO_TORQUE_BIAS * Tn * last_sign
-        level = model.solve_level(T, active)
+        if solved is not None and T in solved:
+            level = solved[T]
+        else:
+            level = model.solve_level(T, active)
+            if solved is not None:
+                solved[T] = level
         active = level.active    # the next level's warm start, solved with the rows it will use
         at = model
         at_full_torque = abs(abs(fraction) - 1.0) < 1e-12
