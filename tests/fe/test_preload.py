@@ -125,6 +125,42 @@ def test_preloaded_wedge_force_balance_and_true_gap():
 
 
 @pytest.mark.slow
+def test_a_ramp_that_cycles_is_cut_back_to_the_state_of_a_finer_ramp(monkeypatch):
+    """A preload ramp whose active-set iteration cycles (HD 120 Table 5 set 14 at 0.169 m on
+    the campaigns' coarse mesh did, in one step of 16 um) is ramped again from the wave
+    generator's state in steps half as large: the same mount as a ramp run at that step
+    from the start (the same FS deflection, the iterations of the failed ramp counted);
+    after ``RAMP_CUTBACKS`` halvings the failure is reported."""
+    real = preload.mount_preloaded
+    calls = []
+
+    def cycling_first(model, level, step):
+        calls.append(step)
+        if len(calls) == 1:
+            model.solver.iterations += 200          # as an active set that cycled to max_iter
+            raise preload.ContactFailure("active-set iteration did not converge")
+        return real(model, level, step)
+
+    monkeypatch.setattr(preload, "mount_preloaded", cycling_first)
+    g, model, cut = _mounted(0.1)
+    assert calls == [preload.RAMP_STEP_M, preload.RAMP_STEP_M / 2]
+    assert cut.preload["ramp_cutbacks"] == 1
+    assert model.iterations > 200
+    monkeypatch.setattr(preload, "mount_preloaded", real)
+    _, _, finer = _mounted(0.1, ramp_step_m=preload.RAMP_STEP_M / 2, monkeypatch=monkeypatch)
+    assert finer.preload["ramp_cutbacks"] == 0
+    assert cut.preload["ramp_steps"] == finer.preload["ramp_steps"]
+    assert cut.deflection_um == pytest.approx(finer.deflection_um, abs=1e-9)
+
+    def always_cycling(model, level, step):
+        raise preload.ContactFailure("active-set iteration did not converge")
+
+    monkeypatch.setattr(preload, "mount_preloaded", always_cycling)
+    r = solve_lost_motion(g, build_mesh(g, **COARSE, symmetry="half"), steps_per_ramp=1)
+    assert r.status == "failed" and "did not converge" in r.reason
+
+
+@pytest.mark.slow
 def test_preload_ramp_converges_to_the_same_state(monkeypatch):
     """The mounted state does not depend on the ramp: 0.05 m per step (the default) and
     0.02 m per step give the same FS deflection at the major axis within the ramp's

@@ -3,7 +3,7 @@
 Stage 1 pushes the wave generator into the FS (no teeth, FS rotation pinned); the cam rows
 are re-linearised at the deformed configuration until the geometry update is below 1e-6 mm.
 With a preload (``DriveGeometry.preloaded``) the teeth are then ramped in at
-zero torque (``preload.mount_preloaded``), every tooth watched.  After stage 1 the teeth
+zero torque (``preload.mount_with_cutback``), every tooth watched.  After stage 1 the teeth
 outside the watched zones are checked for overlap (reported, ``overlap_outside_zones_um``).
 Stage 2 builds the tooth rows at the deflected configuration, frees the FS rotation and
 runs the torque sequence.  At +-T, with preloaded teeth, the tooth and cam rows are settled
@@ -13,8 +13,8 @@ flanks along each other must not leave the gaps of the mounted state, or Phi dep
 the load path and the mesh), then every tooth pair is re-paired from scratch as an
 independent check (``max_penetration_redetected_um``).  The way back starts from the mount's
 rows again: rows settled at +T fit that state only.  Frictionless, a level on the way back
-is then the same problem as the level at that torque on the way up (same rows, same load;
-elastic contact without friction has one solution), so it is not solved again.  Without preload (and in the coning
+is then the way up's problem at that torque (same rows, same load; elastic contact without
+friction has one solution), so it is not solved again.  Without preload (and in the coning
 slices) the near pairs are re-linearised once at +-T if more than 0.05 um penetration is
 re-detected, and those rows are kept for the way back (``redetect_teeth``).
 
@@ -39,7 +39,7 @@ from hdwf.fe.changes import ModelChanges
 from hdwf.fe.contact_rows import ball_rows, cam_rows, fit_rows, tooth_rows
 from hdwf.fe.hertz import ball_max_pressure
 from hdwf.fe.model import ZONE_DEG, LostMotionModel
-from hdwf.fe.preload import PRELOAD_ZONE_DEG, mount_preloaded, overlap_outside_zones
+from hdwf.fe.preload import PRELOAD_ZONE_DEG, mount_with_cutback, overlap_outside_zones
 from hdwf.fe.relinearise import redetect_teeth, settle_teeth
 from hdwf.fe.solver import TOL_GAP, LevelSolution
 
@@ -225,7 +225,7 @@ def mount_wave_generator(model: LostMotionModel,
     preload = None
     if ramp_teeth:     # preloaded (or overlapping) teeth: ramp them in (``preload``)
         free_deflection = float(u[j0])
-        state, preload = mount_preloaded(model, state)
+        state, preload = mount_with_cutback(model, state)
         u = state.u_watch
         preload["wg_retreat_um"] = (free_deflection - float(u[j0])) * 1000.0
     return _MountedWaveGenerator(state, float(u[j0]) * 1000.0, preload,
@@ -260,8 +260,7 @@ def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWave
     active = mounted.solution.active
     twists, maxpen, maxpen_nl, tooth_count, arc = [], 0.0, 0.0, 0, float("nan")
     last_sign = 1.0
-    # frictionless with preloaded teeth, every level is solved with the mount's rows: the way
-    # back poses the same problem as the way up at the same torque, so its solution is reused
+    # frictionless and preloaded, the way back is the way up's problem (module docstring)
     solved = {} if (geom.preloaded and model.changes.flank_friction == 0.0) else None
     for fraction in frac:
         if abs(fraction) > 1e-12:
@@ -331,8 +330,10 @@ def _result(model: LostMotionModel, changes: ModelChanges, frac: np.ndarray,
 def _preload_note(preload: dict | None) -> str:
     if preload is None:
         return ""
+    cut = preload.get("ramp_cutbacks", 0)
     return (f"; preload ramp: overlap {preload['overlap_um']:.2f} um in {preload['ramp_steps']} "
-            f"steps, re-detected penetration at the mount {preload['penetration_um']:.4f} um")
+            f"steps" + (f" (step halved {cut}x: the first ramp's active set cycled)" if cut else "")
+            + f", re-detected penetration at the mount {preload['penetration_um']:.4f} um")
 
 
 def _failed(exc: Exception, model: LostMotionModel | None, t0: float) -> LostMotionResult:

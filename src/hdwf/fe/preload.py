@@ -33,6 +33,7 @@ from hdwf.fe.solver import ContactFailure, LevelSolution
 RAMP_STEP_M = 0.05   # largest drop of the held-back overlap per ramp step, in modules
 STEP_TOL = 5e-4      # mm: re-detected minus linearised gap at the intermediate ramp steps
 PRELOAD_ZONE_DEG = 90.0   # a preload engages far more teeth: watch every tooth
+RAMP_CUTBACKS = 3    # a ramp whose active set cycles is run again in steps halved, up to 3 times
 
 
 def _ramp_step(model: LostMotionModel, level: LevelSolution, hold: float, tol: float
@@ -47,7 +48,8 @@ def _ramp_step(model: LostMotionModel, level: LevelSolution, hold: float, tol: f
     return level, err
 
 
-def mount_preloaded(model: LostMotionModel, level: LevelSolution) -> tuple[LevelSolution, dict]:
+def mount_preloaded(model: LostMotionModel, level: LevelSolution,
+                    ramp_step_m: float = RAMP_STEP_M) -> tuple[LevelSolution, dict]:
     """Ramp the teeth in on a model whose wave generator is mounted without them.
 
     Parameters
@@ -57,6 +59,8 @@ def mount_preloaded(model: LostMotionModel, level: LevelSolution) -> tuple[Level
         the tooth rows are added here.
     level : LevelSolution
         The wave-generator-only solution.
+    ramp_step_m : float
+        Largest drop of the held-back overlap per step, in modules.
 
     Returns
     -------
@@ -73,7 +77,7 @@ def mount_preloaded(model: LostMotionModel, level: LevelSolution) -> tuple[Level
     rows = tooth_rows(st, geom, u, np.inf)
     nodes = rows.slave_nodes
     overlap = max(0.0, float(-(rows.g0 + rows.G @ u).min()))
-    steps = max(1, math.ceil(overlap / (RAMP_STEP_M * geom.module)))
+    steps = max(1, math.ceil(overlap / (ramp_step_m * geom.module)))
     model.rows["tooth"] = held_back(rows, overlap)
     err, hold = 0.0, overlap
     for k in range(1, steps + 1) if overlap > 0 else ():
@@ -93,6 +97,29 @@ def mount_preloaded(model: LostMotionModel, level: LevelSolution) -> tuple[Level
     info = {"overlap_um": overlap * 1000.0, "ramp_steps": steps if overlap > 0 else 0,
             "geometry_error_um": err * 1000.0, "penetration_um": pen * 1000.0}
     return level, info
+
+
+def mount_with_cutback(model: LostMotionModel, level: LevelSolution) -> tuple[LevelSolution, dict]:
+    """``mount_preloaded``; if its active-set iteration cycles, the ramp again from the
+    wave-generator state in steps half as large (at most ``RAMP_CUTBACKS`` times), as an FE
+    code cuts back a load step that does not converge.  Only the rows and the solver state
+    change in a ramp, and before it they hold no tooth pair, so their copy is small.  The
+    record gets ``ramp_cutbacks``; the last failure is raised."""
+    rows, solver = dict(model.rows), model.solver.copy()
+    step = RAMP_STEP_M
+    for cutback in range(RAMP_CUTBACKS + 1):
+        try:
+            mounted, info = mount_preloaded(model, level, step)
+            info["ramp_cutbacks"] = cutback
+            return mounted, info
+        except ContactFailure:
+            if cutback == RAMP_CUTBACKS:
+                raise
+            iterations = model.solver.iterations      # the failed ramp's iterations still count
+            model.rows, model.solver = dict(rows), solver.copy()
+            model.solver.iterations = iterations
+            step /= 2.0
+    raise AssertionError("unreachable")
 
 
 def overlap_outside_zones(model: LostMotionModel, level: LevelSolution) -> float:
