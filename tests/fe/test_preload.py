@@ -265,6 +265,21 @@ def test_frictionless_way_back_passes_through_the_way_up():
     assert tw[8] != tw[0]                    # -0 is its own level (the bias towards -T)
 
 
+@pytest.mark.slow
+def test_a_reused_level_leaves_the_warm_start_the_solved_one_left():
+    """A level reused on the way back must hand the next level the warm start (displacement,
+    ball secants) it left when it was solved, not that of the last level solved (+T).  From
+    +T's, the -T level of HD 120 Table 5 set 10 at 0.05 m (coarse mesh, one step per ramp;
+    the paper_hd120 campaign's grid) cycled to 200 iterations; solved again on the way back
+    (no reuse) it gave phi 2.0596 and phi' 6.4020 arcmin."""
+    g = drive_geometry("hd120", 90.0052963, 119.9971481, 0.034, 0.044444444, 0.043333333,
+                       interference_m=0.05, tip_relief=1.1)
+    r = solve_lost_motion(g, build_mesh(g, **COARSE, symmetry="half"), steps_per_ramp=1)
+    assert r.status == "ok", r.reason
+    assert r.phi_plus_arcmin == pytest.approx(2.0596, abs=0.0033)    # the gap tolerance, as above
+    assert r.phi_minus_arcmin == pytest.approx(6.4020, abs=0.0033)
+
+
 def test_a_deeper_cam_is_sized_to_push_kappa_w0():
     """deflection_coeff kappa sizes the cam so that the nominal bearing (rigid) pushes the FS
     bore out by kappa * w0 at the major axis: cam radius there = d_nom/2 + kappa w0 + G_r,nom/2.

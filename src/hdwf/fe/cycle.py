@@ -268,12 +268,12 @@ def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWave
             T = fraction * Tn
         else:
             T = ZERO_TORQUE_BIAS * Tn * last_sign
-        if solved is not None and T in solved:
-            level = solved[T]
+        if solved is not None and T in solved:   # with the warm start it left for the next level
+            level, model.solver.last_u, model.solver.ball_loads = solved[T]
         else:
             level = model.solve_level(T, active)
             if solved is not None:
-                solved[T] = level
+                solved[T] = (level, model.solver.last_u, model.solver.ball_loads)
         active = level.active    # the next level's warm start, solved with the rows it will use
         at = model
         at_full_torque = abs(abs(fraction) - 1.0) < 1e-12
