@@ -180,3 +180,41 @@ def test_rigid_body_limit_half_equals_full():
     half = _run("hd42", 31.0, 42.0, 0.015, 0.015, 0.010, Escale=1e4, symmetry="half")
     full = _run("hd42", 31.0, 42.0, 0.015, 0.015, 0.010, Escale=1e4)
     assert half.lost_motion_arcmin == pytest.approx(full.lost_motion_arcmin, rel=5e-3)
+
+
+def _fail_at(monkeypatch, torque, times):
+    """``LostMotionModel.solve_level`` raising ContactFailure the first ``times`` times it is
+    asked for ``torque`` (as an active set that cycles does); returns the torques asked for."""
+    from hdwf.fe.solver import ContactFailure
+    real, asked = LostMotionModel.solve_level, []
+
+    def cycling(self, T, active):
+        asked.append(T)
+        if T == torque and asked.count(T) <= times:
+            raise ContactFailure("active-set iteration did not converge in 200 iterations")
+        return real(self, T, active)
+
+    monkeypatch.setattr(LostMotionModel, "solve_level", cycling)
+    return asked
+
+
+def test_a_level_that_cycles_is_reached_through_half_its_step(monkeypatch):
+    """A load level that fails is cut back: the torque halfway from the last level is solved
+    first, then the level from there.  Frictionless, the level has one solution, so Phi is
+    the direct solve's within the gap tolerance (2 x 0.01 um over the CS base radius, 21 mm:
+    0.0033 arcmin); past ``LEVEL_CUTBACKS`` halvings the failure is the result's status."""
+    from hdwf.fe.cycle import ZERO_TORQUE_BIAS
+    g = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.0, 0.0)
+    mesh = build_mesh(g, **COARSE, symmetry="half")
+    direct = solve_lost_motion(g, mesh, steps_per_ramp=1)
+    bias = ZERO_TORQUE_BIAS * g.torque
+    asked = _fail_at(monkeypatch, g.torque, times=1)
+    stepped = solve_lost_motion(g, mesh, steps_per_ramp=1)
+    assert stepped.status == "ok", stepped.reason
+    k = asked.index(g.torque)
+    assert asked[k:k + 3] == [g.torque, 0.5 * (bias + g.torque), g.torque]
+    assert stepped.lost_motion_arcmin == pytest.approx(direct.lost_motion_arcmin, abs=0.0033)
+    _fail_at(monkeypatch, g.torque, times=10)
+    failed = solve_lost_motion(g, mesh, steps_per_ramp=1)
+    assert failed.status == "failed" and "did not converge" in failed.reason
+    assert np.isnan(failed.lost_motion_arcmin)

@@ -11,7 +11,8 @@ at the deformed state: re-detected (nonlinear gap) and re-linearised until every
 contact agrees with its linearisation within 0.05 um (``relinearise.settle``; the twist sliding the
 flanks along each other must not leave the gaps of the mounted state, or Phi depends on
 the load path and the mesh), then every tooth pair is re-paired from scratch as an
-independent check (``max_penetration_redetected_um``).  The way back starts from the mount's
+independent check (``max_penetration_redetected_um``).  A level whose active set cycles is
+reached through the torque halfway from the last one (``LostMotionModel.solve_level_stepped``).  The way back starts from the mount's
 rows again: rows settled at +T fit that state only.  Frictionless, a level on the way back
 is then the way up's problem at that torque (same rows, same load; elastic contact without
 friction has one solution), so it is not solved again.  Without preload (and in the coning
@@ -259,7 +260,7 @@ def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWave
     model.mode_list = model.mode_list + [("fs", "rot")]
     active = mounted.solution.active
     twists, maxpen, maxpen_nl, tooth_count, arc = [], 0.0, 0.0, 0, float("nan")
-    last_sign = 1.0
+    last_sign, last_T = 1.0, 0.0
     # frictionless and preloaded, the way back is the way up's problem (module docstring)
     solved = {} if (geom.preloaded and model.changes.flank_friction == 0.0) else None
     for fraction in frac:
@@ -271,16 +272,15 @@ def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWave
         if solved is not None and T in solved:   # with the warm start it left for the next level
             level, model.solver.last_u, model.solver.ball_loads = solved[T]
         else:
-            level = model.solve_level(T, active)
+            level = model.solve_level_stepped(T, active, last_T)
             if solved is not None:
                 solved[T] = (level, model.solver.last_u, model.solver.ball_loads)
-        active = level.active    # the next level's warm start, solved with the rows it will use
+        active, last_T = level.active, T    # the next level's warm start (with the rows it will use)
         at = model
         at_full_torque = abs(abs(fraction) - 1.0) < 1e-12
         if at_full_torque and model.geometry.preloaded:
-            # preloaded: rows settled at +-T fit that state only, so they are settled on a
-            # fork and the way back starts from the mount's rows (and columns) again
-            at = model.fork()
+            # rows settled at +-T fit that state only: settled on a fork, the way back starts
+            at = model.fork()     # from the mount's rows (and columns) again
             level, pen_nl = settle_teeth(at, T, level)
             model.solver.iterations = at.solver.iterations   # the count includes the settling
             maxpen_nl = max(maxpen_nl, pen_nl)

@@ -21,12 +21,13 @@ from hdwf.fe.changes import ModelChanges
 from hdwf.fe.contact_rows import Rows, stack_rows
 from hdwf.fe.friction import flank_law
 from hdwf.fe.hertz import ball_compliance_coeff
-from hdwf.fe.solver import TOL_GAP, ContactSolver, LevelSolution, SolverSettings
+from hdwf.fe.solver import TOL_GAP, ContactFailure, ContactSolver, LevelSolution, SolverSettings
 from hdwf.fe.structure import ModeName, Structure
 from hdwf.fe.working_set import WorkingSet
 
 
 ZONE_DEG = 35.0   # half width (deg) of the tooth zones about the major axes solved by default
+LEVEL_CUTBACKS = 2   # a load level that does not converge is reached in up to 2 halvings of its step
 # with a preload (``DriveGeometry.preloaded``), an active-set iterate that swings a loaded free mode so
 # far that a pair open before is penetrated by more than this (units of the module m: a quarter
 # of it, beyond the range the linearised tooth rows stand for) is cut back to the first closing
@@ -174,6 +175,22 @@ class LostMotionModel:
     def solve_level(self, torque: float, active: frozenset | None) -> LevelSolution:
         """The contact solution at ``torque`` (N mm), warm-started from ``active``."""
         return self.solver.solve_level(self.structure, self.rows, self.mode_list, torque, active)
+
+    def solve_level_stepped(self, torque: float, active: frozenset | None, from_torque: float,
+                            cutbacks: int = LEVEL_CUTBACKS) -> LevelSolution:
+        """``solve_level``; if it fails (an active set that cycles), the torque halfway from
+        ``from_torque`` (the last level's) is solved first and this one from there, as an FE code
+        cuts back a load step, at most ``cutbacks`` halvings deep.  A failed solve leaves the
+        warm start and the friction state of the last level (it commits them only when it
+        converges), so the retry starts where the failed one did."""
+        try:
+            return self.solve_level(torque, active)
+        except ContactFailure:
+            if cutbacks == 0:
+                raise
+            mid = 0.5 * (from_torque + torque)
+            half = self.solve_level_stepped(mid, active, from_torque, cutbacks - 1)
+            return self.solve_level_stepped(torque, half.active, mid, cutbacks - 1)
 
     def full_displacements(self, solution: LevelSolution, torque: float) -> dict[str, np.ndarray]:
         """Displacement (2, nnodes) of every body at a solved level, u = K^-1 (f + G^T p) + R alpha

@@ -100,9 +100,9 @@ def mount_preloaded(model: LostMotionModel, level: LevelSolution,
 
 
 def mount_with_cutback(model: LostMotionModel, level: LevelSolution) -> tuple[LevelSolution, dict]:
-    """``mount_preloaded``; if its active-set iteration cycles, the ramp again from the
-    wave-generator state in steps half as large (at most ``RAMP_CUTBACKS`` times), as an FE
-    code cuts back a load step that does not converge.  Only the rows and the solver state
+    """``mount_preloaded``; if it fails (an active set that cycles, gaps that do not settle),
+    the ramp again from the wave-generator state in steps half as large (at most
+    ``RAMP_CUTBACKS`` times), as an FE code cuts back a load step that does not converge.  Only the rows and the solver state
     change in a ramp, and before it they hold no tooth pair, so their copy is small.  The
     record gets ``ramp_cutbacks``; the last failure is raised."""
     rows, solver = dict(model.rows), model.solver.copy()
