@@ -256,7 +256,7 @@ def test_frictionless_way_back_passes_through_the_way_up():
     not solved again and the curve comes back through the same points; solved again from
     another warm start it would differ within the gap tolerance (0.4967 against 0.4971 arcmin
     at 0.8 T on Table 4 set 8).  With flank friction nothing is reused, but a preloaded
-    section with friction does not solve today (docs/fe-model.md, Known limits)."""
+    section with friction does not solve today (docs/fe-model.md, Preloaded engagement)."""
     g = drive_geometry(*NOMINAL, interference_m=0.05)
     r = solve_lost_motion(g, build_mesh(g, **COARSE, symmetry="half"), steps_per_ramp=2)
     assert r.status == "ok", r.reason

@@ -11,11 +11,11 @@ at the deformed state: re-detected (nonlinear gap) and re-linearised until every
 contact agrees with its linearisation within 0.05 um (``relinearise.settle``; the twist sliding the
 flanks along each other must not leave the gaps of the mounted state, or Phi depends on
 the load path and the mesh), then every tooth pair is re-paired from scratch as an
-independent check (``max_penetration_redetected_um``).  A level whose active set cycles is
-reached through the torque halfway from the last one (``LostMotionModel.solve_level_stepped``).  The way back starts from the mount's
-rows again: rows settled at +T fit that state only.  Frictionless, a level on the way back
-is then the way up's problem at that torque (same rows, same load; elastic contact without
-friction has one solution), so it is not solved again.  Without preload (and in the coning
+independent check (``max_penetration_redetected_um``).  A level that fails is reached through
+the torque halfway from the last one (``LostMotionModel.solve_level_stepped``).  The way back
+starts from the mount's rows again: rows settled at +T fit that state only.  Frictionless, a
+level on the way back is then the way up's problem at that torque (same rows, same load;
+elastic contact without friction has one solution), so it is not solved again.  Without preload (and in the coning
 slices) the near pairs are re-linearised once at +-T if more than 0.05 um penetration is
 re-detected, and those rows are kept for the way back (``redetect_teeth``).
 
@@ -332,7 +332,7 @@ def _preload_note(preload: dict | None) -> str:
         return ""
     cut = preload.get("ramp_cutbacks", 0)
     return (f"; preload ramp: overlap {preload['overlap_um']:.2f} um in {preload['ramp_steps']} "
-            f"steps" + (f" (step halved {cut}x: the first ramp's active set cycled)" if cut else "")
+            f"steps" + (f" (step halved {cut}x: the first ramp failed)" if cut else "")
             + f", re-detected penetration at the mount {preload['penetration_um']:.4f} um")
 
 

@@ -33,7 +33,7 @@ from hdwf.fe.solver import ContactFailure, LevelSolution
 RAMP_STEP_M = 0.05   # largest drop of the held-back overlap per ramp step, in modules
 STEP_TOL = 5e-4      # mm: re-detected minus linearised gap at the intermediate ramp steps
 PRELOAD_ZONE_DEG = 90.0   # a preload engages far more teeth: watch every tooth
-RAMP_CUTBACKS = 3    # a ramp whose active set cycles is run again in steps halved, up to 3 times
+RAMP_CUTBACKS = 3    # a ramp that fails is run again in steps halved, up to 3 times
 
 
 def _ramp_step(model: LostMotionModel, level: LevelSolution, hold: float, tol: float
@@ -102,9 +102,10 @@ def mount_preloaded(model: LostMotionModel, level: LevelSolution,
 def mount_with_cutback(model: LostMotionModel, level: LevelSolution) -> tuple[LevelSolution, dict]:
     """``mount_preloaded``; if it fails (an active set that cycles, gaps that do not settle),
     the ramp again from the wave-generator state in steps half as large (at most
-    ``RAMP_CUTBACKS`` times), as an FE code cuts back a load step that does not converge.  Only the rows and the solver state
-    change in a ramp, and before it they hold no tooth pair, so their copy is small.  The
-    record gets ``ramp_cutbacks``; the last failure is raised."""
+    ``RAMP_CUTBACKS`` times), as an FE code cuts back a load step that does not converge.
+    Only the rows and the solver state change in a ramp, and before it they hold no tooth
+    pair, so their copy is small.  The record gets ``ramp_cutbacks``; the last failure is
+    raised."""
     rows, solver = dict(model.rows), model.solver.copy()
     step = RAMP_STEP_M
     for cutback in range(RAMP_CUTBACKS + 1):
