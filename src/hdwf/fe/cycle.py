@@ -478,9 +478,9 @@ def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_r
 
 def _preloaded_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int,
                         variants: list[ModelChanges]) -> list[LostMotionResult]:
-    """Preloaded teeth are in from the mount on, and friction or the CS support change the
-    preload: each variant that changes the section mounts its own wave generator; variants
-    that differ only in series elements share that mount and torque sequence."""
+    """Preloaded teeth are in from the mount on and the CS support changes the preload: each
+    variant that changes the section mounts its own wave generator (friction ones too, though
+    mounted without friction); variants differing only in series elements share it all."""
     frac = torque_fractions(steps_per_ramp)
     out, solved = [], {}
     for ch in variants:

@@ -26,6 +26,7 @@ import numpy as np
 
 from hdwf.fe.contact_geometry import boundary_edge_normals, closest_segments
 from hdwf.fe.contact_rows import tooth_rows
+from hdwf.fe.friction import FlankFriction, NoFriction
 from hdwf.fe.model import LostMotionModel
 from hdwf.fe.relinearise import GEO_MAX_IT, GEO_TOL, held_back, penetration, settle
 from hdwf.fe.solver import ContactFailure, LevelSolution
@@ -105,7 +106,26 @@ def mount_with_cutback(model: LostMotionModel, level: LevelSolution) -> tuple[Le
     ``RAMP_CUTBACKS`` times), as an FE code cuts back a load step that does not converge.
     Only the rows and the solver state change in a ramp, and before it they hold no tooth
     pair, so their copy is small.  The record gets ``ramp_cutbacks``; the last failure is
-    raised."""
+    raised.
+
+    The teeth are ramped in without flank friction, which is switched on at the mounted
+    state with the loaded flanks sticking (``FlankFriction.sticking_at``): a drive is
+    assembled axially (the wave generator pushed into the FS, the CS slid over its teeth),
+    so the flanks slide along the axis and keep no tangential force in the section's plane.
+    Ramped in the plane with friction, the flanks would slide sideways against it instead."""
+    law = model.solver.friction
+    model.solver.friction = NoFriction()
+    mounted, info = _ramp_with_cutback(model, level)
+    if isinstance(law, FlankFriction):
+        loaded = [i for i, p in zip(mounted.pair_ids, mounted.normal_force) if p > 0]
+        model.solver.friction = FlankFriction.sticking_at(law.mu, model.structure, model.rows,
+                                                          model.solver.working_set, loaded)
+    else:
+        model.solver.friction = law
+    return mounted, info
+
+
+def _ramp_with_cutback(model: LostMotionModel, level: LevelSolution) -> tuple[LevelSolution, dict]:
     rows, solver = dict(model.rows), model.solver.copy()
     step = RAMP_STEP_M
     for cutback in range(RAMP_CUTBACKS + 1):
