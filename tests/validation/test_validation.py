@@ -11,6 +11,7 @@ from hdwf.validation.calibration import (CalibrationData, Resolver, Response, an
                                          calibrate, refine_fit, responses)
 from hdwf.validation.comparison import Candidate, bic, branches, comparison_points, residual_tests, summarise, verdict
 from hdwf.validation.detectability import detectability
+from hdwf.validation.diagnosis import Search, _GreedySearch
 from hdwf.validation.effects import get
 from hdwf.validation.jsonsafe import json_safe
 from hdwf.validation.variants import plan_variants, variant_key
@@ -188,6 +189,23 @@ def test_anchoring_on_actual_solves_removes_the_tables_interpolation_error():
     assert log["thermal"].solved_at == pytest.approx([lo, (lo + hi) / 2, hi])
 
 
+def test_the_effect_found_in_the_last_round_is_anchored_for_the_final_model():
+    """A search of one round finds thermal on the table's spline (0.19 K off the true 17 K
+    between the kinks) and has no further round to anchor it before. The final model is
+    anchored all the same (one solve of three values), so the estimate the ladder re-solves is
+    the true 17 K, and the log says it was for the final model."""
+    table, obs, twist, solve, calls = _kinked_thermal()
+    resp = responses(table, obs, {}, ["thermal"])
+    data = CalibrationData(twist({"thermal": {"delta_T_K": 17.0}}), twist({}), resp)
+    specimen = obs["specimen_id"].to_numpy()
+    search = _GreedySearch(data, specimen, Search(max_rounds=1), Resolver(solve, obs, {}, dict(resp)))
+    search.run(["thermal"])
+    assert search.on == ["thermal"] and calls == [3]
+    assert search.fit.t[0] == pytest.approx(17.0, abs=1e-6)
+    log = search.refinement["thermal"].as_dict()
+    assert log["status"] == "anchored" and log["final"] is True and "before_round" not in log
+
+
 def test_an_anchored_response_is_exact_at_the_grid_and_off_at_zero():
     """Outside its solved interval the anchored response is the table's spline shifted to meet
     the solves, the shift fading to zero at the next grid value: it stays continuous at the
@@ -258,3 +276,7 @@ def test_report_says_where_an_effect_was_re_solved():
     assert len(texts) == 2
     assert "Before round 2" in texts[0] and "10.1468, 11.1468, 12.1468" in texts[0]
     assert texts[1].startswith("Caution") and "no convergence" in texts[1] and "recalibrated" not in texts[1]
+    doc = Document("t", "s", {})
+    refinement_notes(doc, {"refinement": {"preload": {"status": "anchored", "final": True, "param": "interference_m",
+                                                      "solved_at": [0.18, 0.185, 0.19], "solves": 1}}})
+    assert doc.blocks[0]["text"].startswith("For the final model, preload was recalibrated")

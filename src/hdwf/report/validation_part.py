@@ -79,8 +79,8 @@ def detectability_section(doc: Document, diag: dict, level: int) -> None:
 
 
 def refinement_notes(doc: Document, diag: dict) -> None:
-    """Which found effects the diagnosis re-solved before a further round, and where; a caution
-    for each re-solve that failed or did not settle.
+    """Which found effects the diagnosis re-solved (before a further round, or for the final model)
+    and where; a caution for each re-solve that failed or did not settle.
 
     Parameters
     ----------
@@ -92,9 +92,13 @@ def refinement_notes(doc: Document, diag: dict) -> None:
     for name, r in diag.get("refinement", {}).items():
         if r.get("solved_at"):
             at = ", ".join(f"{v:.6g}" for v in r["solved_at"])
-            doc.text(f"Before round {r['before_round']}, {lit(name)} was recalibrated on actual FE solves of every "
-                     f"specimen at {lit(r['param'])} = {at} (solve {r['solves']}), so that round weighs its candidates "
-                     "against the FE model, not against the interpolation error of the tabulated values.")
+            why = ("so that the final model (the ladder's last rung) is calibrated on the FE model, not on the "
+                   "interpolation of the tabulated values" if r.get("final") else
+                   "so that round weighs its candidates against the FE model, not against the interpolation "
+                   "error of the tabulated values")
+            when = "For the final model" if r.get("final") else f"Before round {r['before_round']}"
+            doc.text(f"{when}, {lit(name)} was recalibrated on actual FE solves of every specimen at "
+                     f"{lit(r['param'])} = {at} (solve {r['solves']}), {why}.")
         if r["status"] in ("failed", "unsettled"):
             doc.text(f"Caution, {lit(name)}: {lit(r['reason'])}.")
 

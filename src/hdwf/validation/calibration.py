@@ -290,10 +290,11 @@ class Resolver:
 @dataclass(frozen=True)
 class Refinement:
     """Where an effect was re-solved (``status`` anchored) or why its response was kept
-    (failed, unsettled: ``reason``)."""
+    (failed, unsettled: ``reason``); before which round, or (``final``) for the final model."""
 
     status: str
     before_round: int | None = None
+    final: bool | None = None
     param: str | None = None
     solved_at: list[float] | None = None
     solves: int | None = None
@@ -397,7 +398,7 @@ def _stale(data: CalibrationData, fit: Fit, resolver: Resolver, done: set) -> di
 
 
 def refine_fit(data: CalibrationData, fit: Fit, resolver: Resolver, log: dict[str, Refinement],
-               before_round: int) -> Fit:
+               before_round: int | None) -> Fit:
     """Recalibrate switched-on effects on actual solves around their estimates.
 
     The response of every effect of ``fit`` that needs a contact solve is anchored to actual
@@ -416,8 +417,8 @@ def refine_fit(data: CalibrationData, fit: Fit, resolver: Resolver, log: dict[st
     log : dict
         ``{effect: Refinement}``: where it was solved, or why the table (or the last anchor)
         was kept; updated in place.
-    before_round : int
-        The search round the refinement precedes (for the log).
+    before_round : int or None
+        The search round the refinement precedes, None for the final model (for the log).
 
     Returns
     -------
@@ -443,7 +444,8 @@ def refine_fit(data: CalibrationData, fit: Fit, resolver: Resolver, log: dict[st
                 log[e] = replace(log.get(e, Refinement("failed")), status="failed", reason=f"{r}; {kept} is used")
                 continue
             data.resp[e], changed = r, True
-            log[e] = Refinement("anchored", before_round, r.param, [r.value(t) for t in r.anchor[0]], n_solve)
+            log[e] = Refinement("anchored", before_round, before_round is None or None, r.param,
+                                [r.value(t) for t in r.anchor[0]], n_solve)
         if changed:
             fit = calibrate(data, on, start=list(fit.t))
     return fit

@@ -222,8 +222,9 @@ class _GreedySearch:
         D, S0 = data.D, data.S0
         self.fit = Fit([], np.zeros(0), np.zeros((0, 0)), S0, float(np.sum((S0 - D) ** 2)), len(D))
 
-    def refine(self, before_round: int) -> None:
-        """With a solver, recalibrate the switched-on effects on actual solves near their estimates."""
+    def refine(self, before_round: int | None) -> None:
+        """With a solver, recalibrate the switched-on effects on actual solves near their
+        estimates: before round ``before_round``, or for the final model (None)."""
         if self.resolver is not None:
             self.fit = refine_fit(self.data, self.fit, self.resolver, self.refinement, before_round)
 
@@ -267,6 +268,9 @@ class _GreedySearch:
             if not remaining or number == self.search.max_rounds:
                 break
             self.refine(number + 1)      # the next round's candidates are calibrated on top of it
+        # the last round's estimates come from the tables (or from solves they have left): the
+        # final model, which the ladder re-solves, is calibrated on actual solves too
+        self.refine(None)
 
 
 def _calibration_data(table: pd.DataFrame, obs: pd.DataFrame, search: Search
