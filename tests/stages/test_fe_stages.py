@@ -1,4 +1,4 @@
-"""The FE study stages with switched-on effects (``fe.effects``): mesh and solve carry them."""
+"""The FE study stages with switched-on effects (``fe.effects``): the mesh and the solve carry them."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 
 from hdwf.drive.design import MeshSettings, geometry_of
 from hdwf.fe import solve_lost_motion
-from hdwf.stages.fe import mesh_stage, refined_solve_stage, solve_stage
+from hdwf.stages.fe import DesignOutputs, refined_solve_stage, solve_stage
 from hdwf.validation.effects import model_changes
 
 # HD 42, Table 3's nominal bearing, r_FS = r_CS = 5 µm
@@ -26,10 +26,10 @@ def test_study_stages_solve_the_switched_on_effects(tmp_path):
     mesh-convergence stage at the study's refinement gives the same Φ."""
     designs = tmp_path / "designs.parquet"
     pd.DataFrame([DESIGN]).to_parquet(designs)
-    mesh_stage(designs, "d1", "hd42", MESH, tmp_path / "d1.msh", tmp_path / "d1.npz", effects=EFFECTS)
-    row = solve_stage(designs, "d1", "hd42", tmp_path / "d1.npz", 1, tmp_path / "row.parquet",
-                      tmp_path / "curve.parquet", {}, effects=EFFECTS)
+    out = DesignOutputs(tmp_path / "d1.msh", tmp_path / "row.parquet", tmp_path / "curve.parquet")
+    row = solve_stage(designs, "d1", "hd42", MESH, 1, out, {}, effects=EFFECTS)
     assert row["status"] == "ok", row["status"]
+    assert out.msh.stat().st_size > 0 and out.curve.exists()
 
     preload_only = model_changes({"preload": EFFECTS["preload"]})
     g = geometry_of("hd42", DESIGN, **preload_only.geometry_part())

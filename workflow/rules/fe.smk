@@ -1,4 +1,4 @@
-# Our FE model: per-design mesh -> solve (one core each, 2 jobs at once on 2 cores), then
+# Our FE model: per-design mesh and solve (one core each, 2 jobs at once on 2 cores), then
 # aggregation into the study's lost_motion.parquet and curves.parquet, and mesh convergence.
 
 rule fe_designs:
@@ -18,32 +18,16 @@ rule fe_designs:
         "../scripts/fe_designs.py"
 
 
-rule fe_mesh:
+rule fe_solve:
+    # mesh and solve in one job: the mesh takes a second or two, less than a job spends starting
     input:
         "results/{study}/{unit}/designs.parquet",
     output:
         msh="results/{study}/{unit}/mesh/{design}.msh",
-        npz="results/{study}/{unit}/mesh/{design}.npz",
-    params:
-        settings={k: FE[k] for k in ("elements_over_height", "elements_over_thickness", "refinement", "symmetry")},
-        effects=FE["effects"],
-    threads: 1
-    benchmark:
-        "results/benchmarks/{study}_{unit}_mesh_{design}.tsv"
-    log:
-        "results/logs/{study}_{unit}_mesh_{design}.log",
-    script:
-        "../scripts/fe_mesh.py"
-
-
-rule fe_solve:
-    input:
-        designs="results/{study}/{unit}/designs.parquet",
-        mesh="results/{study}/{unit}/mesh/{design}.npz",
-    output:
         row="results/{study}/{unit}/designs/{design}.parquet",
         curve="results/{study}/{unit}/designs/{design}_curve.parquet",
     params:
+        settings={k: FE[k] for k in ("elements_over_height", "elements_over_thickness", "refinement", "symmetry")},
         steps_per_ramp=FE["steps_per_ramp"],
         effects=FE["effects"],
     threads: 1

@@ -1,25 +1,19 @@
 """One design, from its table row to a mesh: parameters -> ``DriveGeometry`` -> ``DriveMesh``.
 
 The mesh settings live here in one dataclass (``MeshSettings``) so every caller — the FE study,
-the validation campaigns, the CLI and the benchmarks — meshes the same way.  A mesh is stored as
-``.npz`` (nodes, triangles, named node and edge sets of each body) so a solve never re-meshes.
+the validation campaigns, the CLI and the benchmarks — meshes the same way.
 """
 
 from __future__ import annotations
 
-import json
 from dataclasses import asdict, dataclass
-from pathlib import Path
 from typing import Mapping
 
-import numpy as np
 import pandas as pd
-from skfem import MeshTri
 
 from hdwf import PARAMETER_COLUMNS
-from hdwf.common.io import atomic_path
 from hdwf.drive.geometry import DriveGeometry, drive_geometry
-from hdwf.drive.mesh import BodyMesh, DriveMesh, build_mesh
+from hdwf.drive.mesh import DriveMesh, build_mesh
 
 
 @dataclass(frozen=True)
@@ -75,40 +69,3 @@ def mesh_design(unit: str, params: Mapping[str, float], settings: Mapping | Mesh
     if not isinstance(settings, MeshSettings):
         settings = MeshSettings.from_mapping(settings)
     return settings.mesh(geometry_of(unit, params))
-
-
-def save_drive_mesh(mesh: DriveMesh, path) -> Path:
-    """Write ``mesh`` as ``.npz`` (atomically)."""
-    arrays = {"__sizes__": np.array(json.dumps(mesh.sizes))}
-    for name, body in mesh.bodies.items():
-        arrays[f"{name}:p"] = body.mesh.p
-        arrays[f"{name}:t"] = body.mesh.t
-        arrays[f"{name}:thickness"] = np.array(body.thickness)
-        for k, v in body.node_sets.items():
-            arrays[f"{name}:node:{k}"] = np.asarray(v)
-        for k, v in body.edge_sets.items():
-            arrays[f"{name}:edge:{k}"] = np.asarray(v)
-    with atomic_path(path) as tmp:
-        with open(tmp, "wb") as fh:
-            np.savez_compressed(fh, **arrays)
-    return Path(path)
-
-
-def load_drive_mesh(path) -> DriveMesh:
-    """Read a mesh written by ``save_drive_mesh``."""
-    data = np.load(path)
-    bodies: dict[str, dict] = {}
-    for key in data.files:
-        if key == "__sizes__":
-            continue
-        name, kind, *rest = key.split(":")
-        b = bodies.setdefault(name, {"node_sets": {}, "edge_sets": {}})
-        if kind in ("p", "t", "thickness"):
-            b[kind] = data[key]
-        elif kind == "node":
-            b["node_sets"][rest[0]] = data[key]
-        elif kind == "edge":
-            b["edge_sets"][rest[0]] = data[key]
-    out = {name: BodyMesh(name=name, mesh=MeshTri(b["p"], b["t"]), thickness=float(b["thickness"]),
-                          node_sets=b["node_sets"], edge_sets=b["edge_sets"]) for name, b in bodies.items()}
-    return DriveMesh(bodies=out, sizes=json.loads(str(data["__sizes__"])))

@@ -1,13 +1,14 @@
 """Stages of the FE studies (rules in ``workflow/rules/fe.smk``): design table, per-design mesh
 and solve, aggregation, mesh convergence and the deformed-mesh picture.
 
-A design's mesh is written twice: gmsh's ``.msh`` for review and ``.npz`` that the solve stage
-reads back, so a solve never re-meshes.
+A design is meshed and solved in one job; its gmsh ``.msh`` is kept for review.
 """
 
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Mapping
 
 import numpy as np
@@ -15,7 +16,8 @@ import pandas as pd
 
 from hdwf import PARAMETER_COLUMNS
 from hdwf.common.io import atomic_path, read_parquet_meta, write_parquet
-from hdwf.drive.design import (MeshSettings, design_parameters, geometry_of, load_drive_mesh, save_drive_mesh)
+from hdwf.drive.design import MeshSettings, design_parameters, geometry_of
+from hdwf.drive.mesh import DriveMesh
 from hdwf.drive.geometry import nominal_geometry
 from hdwf.fe import solve_lost_motion
 from hdwf.fe.solver import TOL_GAP
@@ -46,32 +48,42 @@ def _design_model(designs_path, design_id: str, unit: str, effects: Mapping | No
     return params, changes, geometry_of(unit, params, **changes.geometry_part())
 
 
-def mesh_stage(designs_path, design_id: str, unit: str, settings: Mapping, out_msh, out_npz,
-               effects: Mapping | None = None) -> dict:
-    """Mesh one design: gmsh ``.msh`` for review, ``.npz`` for the solver; returns mesh facts.
+def mesh_stage(designs_path, design_id: str, unit: str, settings: Mapping, out_msh,
+               effects: Mapping | None = None) -> DriveMesh:
+    """Mesh one design, writing gmsh's ``.msh`` for review; returns the mesh.
 
     ``effects`` are the study's switched-on effects (``fe.effects``): the preload reshapes the outline.
     """
     _, _, geom = _design_model(designs_path, design_id, unit, effects)
-    t0 = time.perf_counter()
     with atomic_path(out_msh) as tmp_msh:
         # gmsh picks the format from the extension, so the temporary name keeps ".msh".
         tmp_named = tmp_msh.with_suffix(".msh")
         mesh = MeshSettings.from_mapping(settings).mesh(geom, path=str(tmp_named))
         tmp_named.replace(tmp_msh)
-    save_drive_mesh(mesh, out_npz)
-    return {"design_id": design_id, "n_nodes": mesh.n_nodes, "mesh_s": time.perf_counter() - t0}
+    return mesh
 
 
-def solve_stage(designs_path, design_id: str, unit: str, mesh_npz, steps_per_ramp: int, out_row, out_curve,
-                provenance: dict, effects: Mapping | None = None) -> dict:
-    """Solve one meshed design into its row and torque–twist curve (Parquet each), with the
-    study's switched-on ``effects`` (``{name: {parameter: value}}``, those its mesh was made with)."""
+@dataclass(frozen=True)
+class DesignOutputs:
+    """Where one design's solve writes: its mesh (``.msh``), its row and its torque–twist curve."""
+    msh: str | Path
+    row: str | Path
+    curve: str | Path
+
+
+def solve_stage(designs_path, design_id: str, unit: str, settings: Mapping, steps_per_ramp: int,
+                out: DesignOutputs, provenance: dict, effects: Mapping | None = None) -> dict:
+    """Mesh one design and solve it into its row and torque–twist curve (Parquet each), with the
+    study's switched-on ``effects`` (``{name: {parameter: value}}``).  One job does both: the mesh
+    takes a second or two, less than a job of its own spends starting and passing it on."""
+    t0 = time.perf_counter()
+    mesh = mesh_stage(designs_path, design_id, unit, settings, out.msh, effects)
+    mesh_s = time.perf_counter() - t0
     params = design_parameters(designs_path, design_id)
-    row, curve = solve_design(unit, params, load_drive_mesh(mesh_npz), steps_per_ramp, design_id,
-                              changes=model_changes(effects))
-    write_parquet(pd.DataFrame([row]), out_row, provenance=provenance, meta={"unit": unit})
-    write_parquet(curve, out_curve, provenance=provenance, meta={"unit": unit})
+    row, curve = solve_design(unit, params, mesh, steps_per_ramp, design_id, changes=model_changes(effects))
+    row["mesh_s"] = mesh_s
+    write_parquet(pd.DataFrame([row]), out.row, provenance=provenance, meta={"unit": unit})
+    write_parquet(curve, out.curve, provenance=provenance, meta={"unit": unit})
     return row
 
 
