@@ -202,8 +202,9 @@ def test_the_effect_found_in_the_last_round_is_anchored_for_the_final_model():
     search.run(["thermal"])
     assert search.on == ["thermal"] and calls == [3]
     assert search.fit.t[0] == pytest.approx(17.0, abs=1e-6)
-    log = search.refinement["thermal"].as_dict()
-    assert log["status"] == "anchored" and log["final"] is True and "before_round" not in log
+    assert search.refinement == {}                    # no round came after the first
+    log = search.final_refinement["thermal"].as_dict()
+    assert log["status"] == "anchored" and log["solves"] == 1 and "before_round" not in log
 
 
 def test_an_anchored_response_is_exact_at_the_grid_and_off_at_zero():
@@ -277,6 +278,6 @@ def test_report_says_where_an_effect_was_re_solved():
     assert "Before round 2" in texts[0] and "10.1468, 11.1468, 12.1468" in texts[0]
     assert texts[1].startswith("Caution") and "no convergence" in texts[1] and "recalibrated" not in texts[1]
     doc = Document("t", "s", {})
-    refinement_notes(doc, {"refinement": {"preload": {"status": "anchored", "final": True, "param": "interference_m",
-                                                      "solved_at": [0.18, 0.185, 0.19], "solves": 1}}})
+    refinement_notes(doc, {"final": {"refinement": {"preload": {"status": "anchored", "param": "interference_m",
+                                                                "solved_at": [0.18, 0.185, 0.19], "solves": 1}}}})
     assert doc.blocks[0]["text"].startswith("For the final model, preload was recalibrated")

@@ -89,14 +89,16 @@ def refinement_notes(doc: Document, diag: dict) -> None:
     diag
         The campaign's ``diagnosis.json``.
     """
-    for name, r in diag.get("refinement", {}).items():
+    logs = [(name, r, False) for name, r in diag.get("refinement", {}).items()]
+    logs += [(name, r, True) for name, r in diag.get("final", {}).get("refinement", {}).items()]
+    for name, r, final in logs:
         if r.get("solved_at"):
             at = ", ".join(f"{v:.6g}" for v in r["solved_at"])
             why = ("so that the final model (the ladder's last rung) is calibrated on the FE model, not on the "
-                   "interpolation of the tabulated values" if r.get("final") else
+                   "interpolation of the tabulated values" if final else
                    "so that round weighs its candidates against the FE model, not against the interpolation "
                    "error of the tabulated values")
-            when = "For the final model" if r.get("final") else f"Before round {r['before_round']}"
+            when = "For the final model" if final else f"Before round {r['before_round']}"
             doc.text(f"{when}, {lit(name)} was recalibrated on actual FE solves of every specimen at "
                      f"{lit(r['param'])} = {at} (solve {r['solves']}), {why}.")
         if r["status"] in ("failed", "unsettled"):

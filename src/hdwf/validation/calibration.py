@@ -290,11 +290,10 @@ class Resolver:
 @dataclass(frozen=True)
 class Refinement:
     """Where an effect was re-solved (``status`` anchored) or why its response was kept
-    (failed, unsettled: ``reason``); before which round, or (``final``) for the final model."""
+    (failed, unsettled: ``reason``); before which round (None: for the final model)."""
 
     status: str
     before_round: int | None = None
-    final: bool | None = None
     param: str | None = None
     solved_at: list[float] | None = None
     solves: int | None = None
@@ -444,8 +443,7 @@ def refine_fit(data: CalibrationData, fit: Fit, resolver: Resolver, log: dict[st
                 log[e] = replace(log.get(e, Refinement("failed")), status="failed", reason=f"{r}; {kept} is used")
                 continue
             data.resp[e], changed = r, True
-            log[e] = Refinement("anchored", before_round, before_round is None or None, r.param,
-                                [r.value(t) for t in r.anchor[0]], n_solve)
+            log[e] = Refinement("anchored", before_round, r.param, [r.value(t) for t in r.anchor[0]], n_solve)
         if changed:
             fit = calibrate(data, on, start=list(fit.t))
     return fit

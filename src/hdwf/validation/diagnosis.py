@@ -143,7 +143,8 @@ class Diagnosis:
     final_rmse_arcmin: float
     detectability: DataDetectability
     notes: dict[str, str]          # {effect: why (part of) its grid was not used}
-    refinement: dict[str, Refinement]
+    refinement: dict[str, Refinement]          # before a further round
+    final_refinement: dict[str, Refinement]    # after the last round, for the final model
     per_specimen: pd.DataFrame     # the campaign model's error per specimen, worst first
     residual_tests: pd.DataFrame
     # one row per observation: measured D, the campaign model S_model and the final model S_final
@@ -180,7 +181,8 @@ class Diagnosis:
             "rounds": [r.to_dict() for r in self.rounds],
             "found": [asdict(f) for f in self.found],
             "final": {"effects": self.final_effects, "rmse_arcmin": self.final_rmse_arcmin,
-                      "rmse_over_noise": (self.final_rmse_arcmin / self.noise_arcmin) if self.noise_arcmin else None},
+                      "rmse_over_noise": (self.final_rmse_arcmin / self.noise_arcmin) if self.noise_arcmin else None,
+                      "refinement": {e: r.as_dict() for e, r in self.final_refinement.items()}},
             "notes": self.notes,
             "refinement": {e: r.as_dict() for e, r in self.refinement.items()},
             "worst_specimens": self.per_specimen.head(5).to_dict(orient="records"),
@@ -216,7 +218,8 @@ class _GreedySearch:
                  takes_out: Callable[[np.ndarray, np.ndarray], bool] | None = None):
         self.data, self.specimen, self.search, self.resolver = data, specimen, search, resolver
         self.takes_out = takes_out   # (S before, S with a candidate) -> it takes out the clearest component
-        self.refinement: dict[str, Refinement] = {}
+        self.refinement: dict[str, Refinement] = {}         # before a further round
+        self.final_refinement: dict[str, Refinement] = {}   # for the final model
         self.on: list[str] = []
         self.rounds: list[Round] = []
         D, S0 = data.D, data.S0
@@ -226,7 +229,8 @@ class _GreedySearch:
         """With a solver, recalibrate the switched-on effects on actual solves near their
         estimates: before round ``before_round``, or for the final model (None)."""
         if self.resolver is not None:
-            self.fit = refine_fit(self.data, self.fit, self.resolver, self.refinement, before_round)
+            log = self.refinement if before_round is not None else self.final_refinement
+            self.fit = refine_fit(self.data, self.fit, self.resolver, log, before_round)
 
     def calibrate_first(self, effects: list[str]) -> None:
         """Switch ``effects`` on and calibrate them before the search (recalibrated on solves)."""
@@ -378,6 +382,7 @@ def _diagnosis(meas: Measurements, obs: pd.DataFrame, g: _GreedySearch, table_re
         rounds=g.rounds, found=found, final_effects=fit.params(resp),
         final_rmse_arcmin=final_rmse,
         detectability=DataDetectability(sigma, sigma_from, pay, seen), notes=notes, refinement=g.refinement,
+        final_refinement=g.final_refinement,
         per_specimen=per, residual_tests=tests, points=_points(meas, obs, g.data.S0, fit.S, base_points),
         signature=signature)
 
