@@ -367,7 +367,7 @@ def ladder_figure(ladder: pd.DataFrame, noise_arcmin: float | None, title: str, 
         ax.axhline(noise_arcmin, color="tab:gray", ls="--", label=f"noise {noise_arcmin:.4f} arcmin")
     ax.set_xticks(x, ladder["model"], rotation=15, fontsize=8)
     ax.set_ylabel("RMSE (arcmin)")
-    top = max(float(np.nanmax(ladder["rmse_arcmin"], initial=0.0)), noise_arcmin or 0.0)
+    top = max(float(ladder["rmse_arcmin"].fillna(0.0).max()), noise_arcmin or 0.0)
     ax.set_ylim(0, 1.12 * top if top > 0 else None)   # room for the labels
     ax.legend(fontsize=8)
     ax.set_title(title, fontsize=10)
