@@ -264,6 +264,7 @@ def test_frictionless_way_back_passes_through_the_way_up():
     assert tw[8] != tw[0]                    # -0 is its own level (the bias towards -T)
 
 
+@pytest.mark.slow
 def test_flank_friction_is_switched_on_at_the_assembled_preload():
     """A drive is assembled axially, so its preloaded flanks keep no tangential force in the
     section's plane: the teeth are ramped in without friction, which then holds the flanks

@@ -207,6 +207,23 @@ def test_the_effect_found_in_the_last_round_is_anchored_for_the_final_model():
     assert log["status"] == "anchored" and log["solves"] == 1 and "before_round" not in log
 
 
+def test_an_effect_unsettled_in_a_fresh_log_is_logged_not_a_crash(monkeypatch):
+    """The final pass logs into a log of its own, so an effect can run out of solves there
+    without an entry from an earlier solve of that pass (another effect took them all); with
+    no solves allowed at all, that is the first check: it must be logged as unsettled, keeping
+    the table's response, not raise KeyError."""
+    import hdwf.validation.calibration as calibration
+    table, obs, twist, solve, calls = _kinked_thermal()
+    resp = responses(table, obs, {}, ["thermal"])
+    data = CalibrationData(twist({"thermal": {"delta_T_K": 17.0}}), twist({}), resp)
+    plain = calibrate(data, ["thermal"])
+    monkeypatch.setattr(calibration, "ANCHOR_SOLVES", 0)
+    log = {}
+    fit = refine_fit(data, plain, Resolver(solve, obs, {}, dict(resp)), log, before_round=None)
+    assert calls == [] and fit.t[0] == plain.t[0]
+    assert log["thermal"].status == "unsettled" and "after 0 solves" in log["thermal"].reason
+
+
 def test_an_anchored_response_is_exact_at_the_grid_and_off_at_zero():
     """Outside its solved interval the anchored response is the table's spline shifted to meet
     the solves, the shift fading to zero at the next grid value: it stays continuous at the

@@ -1,4 +1,4 @@
-"""The study through a real Slurm cluster: one design's designs -> mesh -> solve chain submitted
+"""The study through a real Slurm cluster: one design's designs -> mesh-and-solve chain submitted
 with `snakemake --profile profiles/slurm` gives the same Φ as the local run.
 
 Brings no cluster up itself: `tools/slurm-cluster up` does (docs/slurm.md). Without a usable

@@ -117,7 +117,7 @@ def test_bad_config_stops_before_any_job(tmp_path):
 
 @pytest.mark.e2e
 def test_fe_study_chain_on_a_coarse_mesh(tmp_path):
-    """Per-design mesh -> solve jobs, benchmark files and the aggregated tables of an FE study
+    """Per-design mesh-and-solve jobs, benchmark files and the aggregated tables of an FE study
     (22 designs, the fewest the quadratic surrogate accepts, on a coarse mesh)."""
     import yaml
 

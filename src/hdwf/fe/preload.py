@@ -115,7 +115,11 @@ def mount_with_cutback(model: LostMotionModel, level: LevelSolution) -> tuple[Le
     Ramped in the plane with friction, the flanks would slide sideways against it instead."""
     law = model.solver.friction
     model.solver.friction = NoFriction()
-    mounted, info = _ramp_with_cutback(model, level)
+    try:
+        mounted, info = _ramp_with_cutback(model, level)
+    except Exception:
+        model.solver.friction = law      # the model as it came, friction and all
+        raise
     if isinstance(law, FlankFriction):
         loaded = [i for i, p in zip(mounted.pair_ids, mounted.normal_force) if p > 0]
         model.solver.friction = FlankFriction.sticking_at(law.mu, model.structure, model.rows,

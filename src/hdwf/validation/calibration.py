@@ -431,7 +431,8 @@ def refine_fit(data: CalibrationData, fit: Fit, resolver: Resolver, log: dict[st
             return fit
         if n_solve > ANCHOR_SOLVES:
             for e in stale:
-                log[e] = replace(log[e], status="unsettled",
+                # (an effect the final pass found inside its solves at first has no entry yet)
+                log[e] = replace(log.get(e, Refinement("unsettled", before_round)), status="unsettled",
                                  reason=f"the estimate still left its solved interval after {ANCHOR_SOLVES} "
                                         "solves; the last anchored response is used")
             return fit

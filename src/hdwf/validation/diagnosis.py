@@ -407,13 +407,16 @@ def diagnose(meas: Measurements, table: pd.DataFrame, search: Search | None = No
         (not the series ones, exact in the tables) is recalibrated on actual solves around its
         estimate (``calibration.refine_fit``), so that the round's candidates are weighed
         against the FE model, not against the tables' interpolation error. Without it, the
-        tables' splines serve throughout.
+        tables' splines serve throughout. After the last round the final model is treated the
+        same way (an estimate outside its solves is solved around once more), so the values
+        the ladder re-solves rest on the FE model too.
 
     Returns
     -------
     Diagnosis
         The rounds, the found effects, the final model, what the data could show, where the
-        model was re-solved (``refinement``) and the comparison points.
+        model was re-solved (``refinement`` before a round, ``final_refinement`` for the final
+        model) and the comparison points.
     """
     search = Search() if search is None else search
     obs = observation_frame(meas)
