@@ -119,7 +119,7 @@ def test_one_design_through_slurm_matches_the_local_run(tmp_path, slurm_cluster)
         rule = Path(log).relative_to(slurm_ws.resolve() / ".snakemake/slurm_logs").parts[0]
         by_rule[rule.removeprefix("rule_")] = (jobid, Path(log))
     assert "fe_solve" in by_rule, slurm_out[-3000:]
-    for rule in ("fe_solve",):
+    for rule in ("fe_solve",):     # the one FE job (mesh and solve)
         jobid, log = by_rule[rule]
         job = _job_fields(jobid)
         assert job["JobState"] == "COMPLETED" and job["ExitCode"] == "0:0", job

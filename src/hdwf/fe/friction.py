@@ -148,15 +148,16 @@ class FlankFriction:
 
     @classmethod
     def sticking_at(cls, mu: float, structure: Structure, rows: dict[str, Rows], working_set: WorkingSet,
-                    loaded: list[PairId]) -> "FlankFriction":
-        """Friction switched on at an assembled state whose flanks carry no tangential force:
-        the slip columns of every working-set pair, and the ``loaded`` tooth pairs sticking
-        there (no slip from that state on until a force leaves the cone)."""
+                    ids: list[PairId], normal_force: np.ndarray) -> "FlankFriction":
+        """Friction switched on at an assembled state (pairs ``ids``, their ``normal_force``)
+        whose flanks carry no tangential force: the slip columns of every working-set pair, and
+        the loaded tooth pairs sticking there (no slip from that state on until a force leaves
+        the cone)."""
         law = cls(mu, structure.nwatch)
         if working_set.pairs:
             law.pairs_added(structure, rows, AddedPairs(list(working_set.pairs), working_set.normal_rows, 0),
                             working_set)
-        law.direction = {i: 0.0 for i in loaded if i[0] == "tooth"}
+        law.direction = {i: 0.0 for i, p in zip(ids, normal_force) if i[0] == "tooth" and p > 0}
         return law
 
     @property

@@ -121,9 +121,8 @@ def mount_with_cutback(model: LostMotionModel, level: LevelSolution) -> tuple[Le
         model.solver.friction = law      # the model as it came, friction and all
         raise
     if isinstance(law, FlankFriction):
-        loaded = [i for i, p in zip(mounted.pair_ids, mounted.normal_force) if p > 0]
-        model.solver.friction = FlankFriction.sticking_at(law.mu, model.structure, model.rows,
-                                                          model.solver.working_set, loaded)
+        model.solver.friction = FlankFriction.sticking_at(law.mu, model.structure, model.rows, model.solver.working_set,
+                                                          mounted.pair_ids, mounted.normal_force)
     else:
         model.solver.friction = law
     return mounted, info

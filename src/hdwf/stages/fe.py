@@ -48,13 +48,8 @@ def _design_model(designs_path, design_id: str, unit: str, effects: Mapping | No
     return params, changes, geometry_of(unit, params, **changes.geometry_part())
 
 
-def mesh_stage(designs_path, design_id: str, unit: str, settings: Mapping, out_msh,
-               effects: Mapping | None = None) -> DriveMesh:
-    """Mesh one design, writing gmsh's ``.msh`` for review; returns the mesh.
-
-    ``effects`` are the study's switched-on effects (``fe.effects``): the preload reshapes the outline.
-    """
-    _, _, geom = _design_model(designs_path, design_id, unit, effects)
+def _mesh_to(geom, settings: Mapping, out_msh) -> DriveMesh:
+    """Mesh a design's geometry, writing gmsh's ``.msh`` for review; returns the mesh."""
     with atomic_path(out_msh) as tmp_msh:
         # gmsh picks the format from the extension, so the temporary name keeps ".msh".
         tmp_named = tmp_msh.with_suffix(".msh")
@@ -76,11 +71,11 @@ def solve_stage(designs_path, design_id: str, unit: str, settings: Mapping, step
     """Mesh one design and solve it into its row and torque–twist curve (Parquet each), with the
     study's switched-on ``effects`` (``{name: {parameter: value}}``).  One job does both: the mesh
     takes a second or two, less than a job of its own spends starting and passing it on."""
+    params, changes, geom = _design_model(designs_path, design_id, unit, effects)   # the preload reshapes the outline
     t0 = time.perf_counter()
-    mesh = mesh_stage(designs_path, design_id, unit, settings, out.msh, effects)
+    mesh = _mesh_to(geom, settings, out.msh)
     mesh_s = time.perf_counter() - t0
-    params = design_parameters(designs_path, design_id)
-    row, curve = solve_design(unit, params, mesh, steps_per_ramp, design_id, changes=model_changes(effects))
+    row, curve = solve_design(unit, params, mesh, steps_per_ramp, design_id, changes=changes)
     row["mesh_s"] = mesh_s
     write_parquet(pd.DataFrame([row]), out.row, provenance=provenance, meta={"unit": unit})
     write_parquet(curve, out.curve, provenance=provenance, meta={"unit": unit})
