@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from hdwf.drive.geometry import ARCMIN, drive_geometry, geometric_backlash_arcmin
-from hdwf.drive.mesh import DriveMesh, build_mesh
-from hdwf.fe import LostMotionModel, solve_lost_motion
+from hdwf.drive.mesh import DriveMesh, build_mesh, share_bodies
+from hdwf.fe import LostMotionModel, ModelChanges, solve_lost_motion
 
 COARSE = dict(elements_over_height=6, elements_over_thickness=4, refinement=1.0)
 
@@ -218,3 +218,71 @@ def test_a_level_that_cycles_is_reached_through_half_its_step(monkeypatch):
     failed = solve_lost_motion(g, mesh, steps_per_ramp=1)
     assert failed.status == "failed" and "did not converge" in failed.reason
     assert np.isnan(failed.lost_motion_arcmin)
+
+
+def _assert_same_body(a, b, tol_mm=1e-6):
+    """Two meshes of one body are the same up to node numbering: every node of ``b`` lies within
+    ``tol_mm`` of its own node of ``a`` (a bijection), and through that map the triangles and
+    named edges agree."""
+    from scipy.spatial import cKDTree
+
+    dist, match = cKDTree(a.mesh.p.T).query(b.mesh.p.T)
+    assert dist.max() < tol_mm and np.unique(match).size == match.size == a.mesh.p.shape[1]
+
+    def cells(c):
+        c = np.sort(c, axis=1)
+        return c[np.lexsort(c.T[::-1])]
+    assert np.array_equal(cells(match[b.mesh.t.T]), cells(a.mesh.t.T))
+    assert a.edge_sets.keys() == b.edge_sets.keys()
+    for k in a.edge_sets:
+        assert np.array_equal(cells(match[b.edge_sets[k]]), cells(a.edge_sets[k])), k
+
+
+def test_a_body_meshed_alone_is_the_body_of_the_whole_drive():
+    """Each body has its own curves and surface: meshed alone it gets the same triangles and
+    named edges as in the whole drive (gmsh may number them apart), its nodes within 1e-6 mm
+    of theirs (gmsh's round-off; the solver resolves gaps of 1e-5 mm)."""
+    g = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.005, 0.005, interference_m=0.1, tip_relief=1.1)
+    whole = build_mesh(g, **COARSE, symmetry="half")
+    for only in (("fs",), ("cs", "ir", "or")):
+        part = build_mesh(g, **COARSE, symmetry="half", bodies=only)
+        assert set(part.bodies) == set(only) and part.sizes == whole.sizes
+        for name in only:
+            _assert_same_body(whole.bodies[name], part.bodies[name])
+    with pytest.raises(ValueError, match="bodies must be some of"):
+        build_mesh(g, **COARSE, bodies=("fs", "wave generator"))
+    with pytest.raises(ValueError, match="differ in symmetry or density"):
+        share_bodies(build_mesh(g, **COARSE, bodies=("fs",)), whole)
+
+
+@pytest.mark.slow
+def test_models_of_two_allowances_share_the_cs_and_rings_and_solve_as_alone():
+    """Two allowances of one design differ in the FS teeth only: the second model takes the
+    first one's CS and bearing rings (the same factorisations; it factorises only its FS) and
+    gives the Φ it gives with bodies of its own, to the contact tolerance (2 tol / r_b); a CS on
+    a housing is not taken."""
+    from hdwf.fe.cycle import solve_lost_motion_variants
+    from hdwf.fe.model import SharedBodies
+    from hdwf.fe.solver import TOL_GAP
+    from hdwf.study.convergence import twist_resolution_arcmin
+
+    args = ("hd42", 31.0, 42.0, 0.015, 0.005, 0.005)
+    g1 = drive_geometry(*args, interference_m=0.1, tip_relief=1.1)
+    g2 = drive_geometry(*args, interference_m=0.15, tip_relief=1.1)
+    m1 = build_mesh(g1, **COARSE, symmetry="half")
+    m2 = share_bodies(build_mesh(g2, **COARSE, symmetry="half", bodies=("fs",)), m1)
+    shared = SharedBodies()
+    first = LostMotionModel(g1, m1, zone_deg=90.0, shared=shared)
+    second = LostMotionModel(g2, m2, zone_deg=90.0, shared=shared)
+    for name in ("cs", "ir", "or"):
+        assert second.bodies[name].factor is first.bodies[name].factor
+    assert second.bodies["fs"].factor is not first.bodies["fs"].factor
+    housed = LostMotionModel(g2, m2, zone_deg=90.0, shared=shared,
+                             changes=ModelChanges(cs_rim_stiffness_N_mm2=2000.0))
+    assert housed.bodies["cs"].factor is not first.bodies["cs"].factor
+    assert housed.bodies["or"].factor is first.bodies["or"].factor
+    with_shared = solve_lost_motion_variants(g2, m2, 1, [ModelChanges()], shared)[0]
+    alone = solve_lost_motion(g2, build_mesh(g2, **COARSE, symmetry="half"), steps_per_ramp=1)
+    assert with_shared.status == alone.status == "ok"
+    assert with_shared.lost_motion_arcmin == pytest.approx(
+        alone.lost_motion_arcmin, abs=twist_resolution_arcmin(TOL_GAP, g2.r_cs_base) / 2)

@@ -8,6 +8,8 @@ import pytest
 from hdwf.drive.design import MeshSettings, geometry_of
 from hdwf.drive.relief import PRELOAD_TIP_RELIEF
 from hdwf.fe import ModelChanges, solve_lost_motion
+from hdwf.fe.solver import TOL_GAP
+from hdwf.study.convergence import twist_resolution_arcmin
 from hdwf.validation.effects import model_changes
 from hdwf.validation.variants import SolveSetup, candidate_names, plan_variants, solve_specimen
 
@@ -34,11 +36,14 @@ def test_a_reshaping_change_needs_its_geometry():
 
 @pytest.mark.slow
 def test_preload_variants_equal_their_own_solves_and_take_the_clearance_up():
-    """``solve_specimen`` meshes each preloaded outline apart: each variant's twists equal a solve
-    of that geometry on its own mesh (the sharing reorganises, never changes, a solve), and the
-    baseline beside them is unchanged. Past δ·m = r_FS + r_CS (10 µm, 0.056 m) the rigid clearance
-    2 (r_FS + r_CS − δ m) / r_b is negative: no play is left, Φ is elastic only, below a tenth of
-    the baseline's 3.4 arcmin of play; and Φ falls as the teeth thicken."""
+    """``solve_specimen`` meshes the first preloaded outline whole and the next ones' FS only, on
+    the same CS and rings, assembled and factorised once: each variant's twists equal a solve of
+    that geometry on its own whole mesh (the first exactly; the others to the contact tolerance,
+    tol / r_b per twist of each solve: their FS meshes agree to round-off and their columns come
+    from shared responses), and the baseline beside them is unchanged. Past δ·m = r_FS + r_CS (10 µm,
+    0.056 m) the rigid clearance 2 (r_FS + r_CS − δ m) / r_b is negative: no play is left, Φ is
+    elastic only, below a tenth of the baseline's 3.4 arcmin of play; and Φ falls as the teeth
+    thicken."""
     setup = SolveSetup("hd42", MESH, steps_per_ramp=1)
     variants = [{}, {"preload": {"interference_m": 0.05}}, {"preload": {"interference_m": 0.1}}]
     table = solve_specimen(setup, SPECIMEN, variants)
@@ -49,7 +54,11 @@ def test_preload_variants_equal_their_own_solves_and_take_the_clearance_up():
         changes = model_changes(effects)
         g = geometry_of("hd42", SPECIMEN, **changes.geometry_part())
         alone = solve_lost_motion(g, MeshSettings.from_mapping(MESH).mesh(g), 1, changes=changes)
-        assert np.array_equal(part["twist_arcmin"].to_numpy(), alone.twist_arcmin), key
+        if key == "preload:interference_m=0.1":     # the outline that took the shared bodies
+            tol = twist_resolution_arcmin(TOL_GAP, g.r_cs_base) / 2   # two solves, tol / r_b each
+            np.testing.assert_allclose(part["twist_arcmin"].to_numpy(), alone.twist_arcmin, rtol=0, atol=tol)
+        else:
+            assert np.array_equal(part["twist_arcmin"].to_numpy(), alone.twist_arcmin), key
         phi[key] = alone.lost_motion_arcmin
     base, mid, locked = phi["baseline"], phi["preload:interference_m=0.05"], phi["preload:interference_m=0.1"]
     assert base == pytest.approx(3.4, rel=0.15)

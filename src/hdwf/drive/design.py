@@ -13,7 +13,7 @@ import pandas as pd
 
 from hdwf import PARAMETER_COLUMNS
 from hdwf.drive.geometry import DriveGeometry, drive_geometry
-from hdwf.drive.mesh import DriveMesh, build_mesh
+from hdwf.drive.mesh import BODY_NAMES, DriveMesh, build_mesh
 
 
 @dataclass(frozen=True)
@@ -40,10 +40,10 @@ class MeshSettings:
     def as_dict(self) -> dict:
         return asdict(self)
 
-    def mesh(self, geom: DriveGeometry, path: str | None = None) -> DriveMesh:
-        """Mesh ``geom``; with ``path`` gmsh also writes its ``.msh`` there."""
+    def mesh(self, geom: DriveGeometry, path: str | None = None, bodies: tuple[str, ...] = BODY_NAMES) -> DriveMesh:
+        """Mesh ``geom`` (its ``bodies``); with ``path`` gmsh also writes its ``.msh`` there."""
         return build_mesh(geom, self.elements_over_height, self.elements_over_thickness, self.refinement,
-                          path=path, symmetry=self.symmetry)
+                          path=path, symmetry=self.symmetry, bodies=bodies)
 
 
 def design_parameters(designs_path, design_id: str) -> dict[str, float]:

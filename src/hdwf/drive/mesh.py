@@ -195,10 +195,14 @@ def _cs_outline(geo, g: DriveGeometry, c: int, s: dict) -> tuple[list[int], list
     return _toothed_outline(geo, g.z_cs, rr, cs_half_space_angle(g, rr), c, s["tooth"])
 
 
+BODY_NAMES = ("fs", "cs", "ir", "or")
+
+
 def build_mesh(geom: DriveGeometry, elements_over_height: int = 10,
                elements_over_thickness: int = 6, refinement: float = 1.0,
-               path: str | None = None, symmetry: str = "full") -> DriveMesh:
-    """Mesh the four bodies; write ``path`` (.msh) if given; return per-body meshes.
+               path: str | None = None, symmetry: str = "full",
+               bodies: tuple[str, ...] = BODY_NAMES) -> DriveMesh:
+    """Mesh the four bodies (or some); write ``path`` (.msh) if given; return per-body meshes.
 
     Parameters
     ----------
@@ -208,15 +212,20 @@ def build_mesh(geom: DriveGeometry, elements_over_height: int = 10,
     path : where gmsh writes its binary ``.msh`` (for review), or None.
     symmetry : ``"half"`` meshes only the upper half of every body (see the module
         docstring); ``"full"`` (default) the whole drive.
+    bodies : the bodies to mesh.  Each body has its own curves and surface, so a body meshed
+        alone gets the same nodes and triangles as in the whole drive (``share_bodies``).
 
     Returns
     -------
-    DriveMesh : the FS, CS and bearing rings with their named node and edge sets.
+    DriveMesh : the FS, CS and bearing rings (those asked for) with their named node and edge sets.
     """
     g = geom
     if symmetry not in ("full", "half"):
         raise ValueError(f"symmetry must be 'full' or 'half', not {symmetry!r}")
     half = symmetry == "half"
+    unknown = set(bodies) - set(BODY_NAMES)
+    if unknown or not bodies:
+        raise ValueError(f"bodies must be some of {BODY_NAMES}, not {bodies!r}")
     if half and (g.z_fs % 2 or g.z_cs % 2 or g.n_balls % 2):
         raise ValueError("half model needs even tooth and ball counts (180 deg symmetry)")
     s = _sizes(g, elements_over_height, elements_over_thickness, refinement)
@@ -230,7 +239,7 @@ def build_mesh(geom: DriveGeometry, elements_over_height: int = 10,
         groups: dict[str, tuple[int, list[int]]] = {}
         cuts: list[tuple[int, int]] = []     # (line at angle pi, line at angle 0)
         build = _half_geometry if half else _full_geometry
-        curves = build(geo, g, c, s, groups, cuts)
+        curves = build(geo, g, c, s, groups, cuts, set(bodies))
         geo.synchronize()
         _mesh_controls(g, s, curves, cuts)
         for name, (dim, tags) in groups.items():
@@ -247,14 +256,24 @@ def build_mesh(geom: DriveGeometry, elements_over_height: int = 10,
         ntags, coords, _ = gmsh.model.mesh.getNodes()
         xy = np.zeros((int(ntags.max()) + 1, 2))
         xy[ntags.astype(np.int64)] = coords.reshape(-1, 3)[:, :2]
-        bodies = {name: _extract_body(name, groups, xy, thick, bnames) for name, thick, bnames in (
+        meshes = {name: _extract_body(name, groups, xy, thick, bnames) for name, thick, bnames in (
             ("fs", g.face_fs, ["fs_teeth", "fs_bore"]), ("cs", g.face_cs, ["cs_teeth", "cs_outer"]),
-            ("ir", g.B, ["ir_bore", "ir_race"]), ("or", g.B, ["or_race", "or_outer"]))}
+            ("ir", g.B, ["ir_bore", "ir_race"]), ("or", g.B, ["or_race", "or_outer"])) if name in bodies}
     finally:
         gmsh.finalize()
     if half:
         s["symmetry_half"] = 1.0
-    return DriveMesh(bodies, s, symmetry)
+    return DriveMesh(meshes, s, symmetry)
+
+
+def share_bodies(fs_mesh: DriveMesh, others: DriveMesh) -> DriveMesh:
+    """The drive of ``fs_mesh``'s FS with the CS and bearing rings of ``others`` (the same
+    objects): for outlines that differ in the FS teeth only (a preload's allowance), whose
+    other bodies are then meshed, assembled and factorised once."""
+    if fs_mesh.symmetry != others.symmetry or fs_mesh.sizes != others.sizes:
+        raise ValueError("share_bodies: the meshes differ in symmetry or density")
+    return DriveMesh({"fs": fs_mesh.bodies["fs"], **{n: others.bodies[n] for n in BODY_NAMES[1:]}},
+                     dict(others.sizes), others.symmetry)
 
 
 def _mesh_controls(g: DriveGeometry, s: dict, curves: tuple, cuts: list) -> None:
@@ -307,71 +326,76 @@ def _extract_body(name: str, groups: dict, xy: np.ndarray, thickness: float, bou
     return bm
 
 
-def _full_geometry(geo, g: DriveGeometry, c: int, s: dict, groups: dict, cuts: list):
-    """The four whole bodies (FS, CS, bearing inner and outer ring); fills ``groups``.
+def _full_geometry(geo, g: DriveGeometry, c: int, s: dict, groups: dict, cuts: list, bodies: set):
+    """The whole bodies named in ``bodies`` (FS, CS, bearing inner and outer ring); fills ``groups``.
 
-    ``cuts`` stays empty (no symmetry cut); same signature and return as ``_half_geometry``."""
-    fs_out, fs_fl = _fs_outline(geo, g, c, s)
-    fs_bore = _circle(geo, g.r_fs_bore, s["fs_bore"], c)
-    fs_surf = geo.addPlaneSurface([geo.addCurveLoop(fs_out), geo.addCurveLoop(fs_bore)])
-    groups["fs"] = (2, [fs_surf])
-    groups["fs_teeth"] = (1, fs_out)
-    groups["fs_bore"] = (1, fs_bore)
-    cs_in, cs_fl = _cs_outline(geo, g, c, s)
-    cs_outer = _circle(geo, g.r_cs_outer, s["cs_outer"], c)
-    cs_surf = geo.addPlaneSurface([geo.addCurveLoop(cs_outer), geo.addCurveLoop(cs_in)])
-    groups["cs"] = (2, [cs_surf])
-    groups["cs_teeth"] = (1, cs_in)
-    groups["cs_outer"] = (1, cs_outer)
-    ir_bore = _circle(geo, g.ir_bore, s["ring"], c)
-    ir_race = _circle(geo, g.ir_race, s["ring"], c)
-    ir_surf = geo.addPlaneSurface([geo.addCurveLoop(ir_race), geo.addCurveLoop(ir_bore)])
-    or_race = _circle(geo, g.or_race, s["ring"], c)
-    or_outer = _circle(geo, g.or_outer, s["ring"], c)
-    or_surf = geo.addPlaneSurface([geo.addCurveLoop(or_outer), geo.addCurveLoop(or_race)])
-    groups.update({"ir": (2, [ir_surf]), "ir_bore": (1, ir_bore), "ir_race": (1, ir_race),
-                   "or": (2, [or_surf]), "or_race": (1, or_race), "or_outer": (1, or_outer)})
+    ``cuts`` stays empty (no symmetry cut); same signature and return as ``_half_geometry``
+    (the curves of a body not built are empty)."""
+    fs_fl = cs_fl = fs_bore = cs_outer = ir_bore = ir_race = or_race = or_outer = []
+    if "fs" in bodies:
+        fs_out, fs_fl = _fs_outline(geo, g, c, s)
+        fs_bore = _circle(geo, g.r_fs_bore, s["fs_bore"], c)
+        fs_surf = geo.addPlaneSurface([geo.addCurveLoop(fs_out), geo.addCurveLoop(fs_bore)])
+        groups.update({"fs": (2, [fs_surf]), "fs_teeth": (1, fs_out), "fs_bore": (1, fs_bore)})
+    if "cs" in bodies:
+        cs_in, cs_fl = _cs_outline(geo, g, c, s)
+        cs_outer = _circle(geo, g.r_cs_outer, s["cs_outer"], c)
+        cs_surf = geo.addPlaneSurface([geo.addCurveLoop(cs_outer), geo.addCurveLoop(cs_in)])
+        groups.update({"cs": (2, [cs_surf]), "cs_teeth": (1, cs_in), "cs_outer": (1, cs_outer)})
+    if "ir" in bodies:
+        ir_bore = _circle(geo, g.ir_bore, s["ring"], c)
+        ir_race = _circle(geo, g.ir_race, s["ring"], c)
+        ir_surf = geo.addPlaneSurface([geo.addCurveLoop(ir_race), geo.addCurveLoop(ir_bore)])
+        groups.update({"ir": (2, [ir_surf]), "ir_bore": (1, ir_bore), "ir_race": (1, ir_race)})
+    if "or" in bodies:
+        or_race = _circle(geo, g.or_race, s["ring"], c)
+        or_outer = _circle(geo, g.or_outer, s["ring"], c)
+        or_surf = geo.addPlaneSurface([geo.addCurveLoop(or_outer), geo.addCurveLoop(or_race)])
+        groups.update({"or": (2, [or_surf]), "or_race": (1, or_race), "or_outer": (1, or_outer)})
     return fs_fl, cs_fl, fs_bore, ir_bore, ir_race, or_race, or_outer, cs_outer
 
 
-def _half_geometry(geo, g: DriveGeometry, c: int, s: dict, groups: dict, cuts: list):
-    """Upper halves of the four bodies, each closed by two radial cut lines on the x axis
-    (inner -> outer radius at angle 0 and at angle pi); fills ``groups`` and ``cuts``."""
+def _half_geometry(geo, g: DriveGeometry, c: int, s: dict, groups: dict, cuts: list, bodies: set):
+    """Upper halves of the bodies named in ``bodies``, each closed by two radial cut lines on
+    the x axis (inner -> outer radius at angle 0 and at angle pi); fills ``groups`` and ``cuts``."""
     def cut_pair(p_in0, p_out0, p_in1, p_out1):
         l0 = geo.addLine(p_in0, p_out0)
         l1 = geo.addLine(p_in1, p_out1)
         cuts.append((l1, l0))
         return l0, l1
 
-    # --- FS: toothed outline 0 -> pi, bore pi -> 0
-    rr = _relieved_radii(g, g.r_fs_root, g.r_fs_tip, g.r_fs_tip)
-    fs_out, fs_fl, o0, o1 = _toothed_half_outline(geo, g.z_fs, rr, fs_half_angle(g, rr), c,
-                                                  s["tooth"])
-    fs_bore, bp = _half_circle(geo, g.r_fs_bore, s["fs_bore"], c)
-    l0, l1 = cut_pair(bp[0], o0, bp[2], o1)
-    loop = fs_out + [-l1] + [-a for a in fs_bore[::-1]] + [l0]
-    fs_surf = geo.addPlaneSurface([geo.addCurveLoop(loop)])
-    groups.update({"fs": (2, [fs_surf]), "fs_teeth": (1, fs_out), "fs_bore": (1, fs_bore)})
-    # --- CS: outer rim 0 -> pi, toothed inner outline pi -> 0
-    rr = _relieved_radii(g, g.r_cs_tip, g.r_cs_root, g.r_cs_tip)
-    cs_in, cs_fl, i0, i1 = _toothed_half_outline(geo, g.z_cs, rr, cs_half_space_angle(g, rr),
-                                                 c, s["tooth"])
-    cs_outer, op = _half_circle(geo, g.r_cs_outer, s["cs_outer"], c)
-    l0, l1 = cut_pair(i0, op[0], i1, op[2])
-    loop = [l0] + cs_outer + [-l1] + [-a for a in cs_in[::-1]]
-    cs_surf = geo.addPlaneSurface([geo.addCurveLoop(loop)])
-    groups.update({"cs": (2, [cs_surf]), "cs_teeth": (1, cs_in), "cs_outer": (1, cs_outer)})
-    # --- bearing rings
+    fs_fl = cs_fl = fs_bore = cs_outer = ir_bore = ir_race = or_race = or_outer = []
+    if "fs" in bodies:    # toothed outline 0 -> pi, bore pi -> 0
+        rr = _relieved_radii(g, g.r_fs_root, g.r_fs_tip, g.r_fs_tip)
+        fs_out, fs_fl, o0, o1 = _toothed_half_outline(geo, g.z_fs, rr, fs_half_angle(g, rr), c,
+                                                      s["tooth"])
+        fs_bore, bp = _half_circle(geo, g.r_fs_bore, s["fs_bore"], c)
+        l0, l1 = cut_pair(bp[0], o0, bp[2], o1)
+        loop = fs_out + [-l1] + [-a for a in fs_bore[::-1]] + [l0]
+        fs_surf = geo.addPlaneSurface([geo.addCurveLoop(loop)])
+        groups.update({"fs": (2, [fs_surf]), "fs_teeth": (1, fs_out), "fs_bore": (1, fs_bore)})
+    if "cs" in bodies:    # outer rim 0 -> pi, toothed inner outline pi -> 0
+        rr = _relieved_radii(g, g.r_cs_tip, g.r_cs_root, g.r_cs_tip)
+        cs_in, cs_fl, i0, i1 = _toothed_half_outline(geo, g.z_cs, rr, cs_half_space_angle(g, rr),
+                                                     c, s["tooth"])
+        cs_outer, op = _half_circle(geo, g.r_cs_outer, s["cs_outer"], c)
+        l0, l1 = cut_pair(i0, op[0], i1, op[2])
+        loop = [l0] + cs_outer + [-l1] + [-a for a in cs_in[::-1]]
+        cs_surf = geo.addPlaneSurface([geo.addCurveLoop(loop)])
+        groups.update({"cs": (2, [cs_surf]), "cs_teeth": (1, cs_in), "cs_outer": (1, cs_outer)})
+
     def ring(r_in, r_out):
         inner, ip = _half_circle(geo, r_in, s["ring"], c)
         outer, op = _half_circle(geo, r_out, s["ring"], c)
         l0, l1 = cut_pair(ip[0], op[0], ip[2], op[2])
         loop = [l0] + outer + [-l1] + [-a for a in inner[::-1]]
         return geo.addPlaneSurface([geo.addCurveLoop(loop)]), inner, outer
-    ir_surf, ir_bore, ir_race = ring(g.ir_bore, g.ir_race)
-    or_surf, or_race, or_outer = ring(g.or_race, g.or_outer)
-    groups.update({"ir": (2, [ir_surf]), "ir_bore": (1, ir_bore), "ir_race": (1, ir_race),
-                   "or": (2, [or_surf]), "or_race": (1, or_race), "or_outer": (1, or_outer)})
+    if "ir" in bodies:
+        ir_surf, ir_bore, ir_race = ring(g.ir_bore, g.ir_race)
+        groups.update({"ir": (2, [ir_surf]), "ir_bore": (1, ir_bore), "ir_race": (1, ir_race)})
+    if "or" in bodies:
+        or_surf, or_race, or_outer = ring(g.or_race, g.or_outer)
+        groups.update({"or": (2, [or_surf]), "or_race": (1, or_race), "or_outer": (1, or_outer)})
     return fs_fl, cs_fl, fs_bore, ir_bore, ir_race, or_race, or_outer, cs_outer
 
 

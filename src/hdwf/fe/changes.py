@@ -43,7 +43,7 @@ class ModelChanges:
     * ``flank_interference_m``: preloaded engagement, the FS teeth thicker by this many modules
       on each flank (``DriveGeometry.interference_m``), their tips relieved as a preload needs
       (``hdwf.drive.relief.PRELOAD_TIP_RELIEF``). It changes the section's outline, so the
-      geometry must carry it (``geometry_part``): a variant with it is meshed on its own.
+      geometry must carry it (``geometry_part``): a variant with it gets an FS meshed on its own.
     * ``flank_layer_m``: a compliant layer on the tooth flanks, as compliant as a steel layer
       this many modules thick: c = flank_layer_m m / E (mm of approach per MPa of contact
       pressure), in series with every tooth pair over its share of the flank (``contact_rows``).

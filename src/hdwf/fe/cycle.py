@@ -39,7 +39,7 @@ from hdwf.drive.mesh import DriveMesh
 from hdwf.fe.changes import ModelChanges
 from hdwf.fe.contact_rows import ball_rows, cam_rows, fit_rows, tooth_rows
 from hdwf.fe.hertz import ball_max_pressure
-from hdwf.fe.model import ZONE_DEG, LostMotionModel
+from hdwf.fe.model import ZONE_DEG, LostMotionModel, SharedBodies
 from hdwf.fe.preload import PRELOAD_ZONE_DEG, mount_with_cutback, overlap_outside_zones
 from hdwf.fe.relinearise import redetect_teeth, settle_teeth
 from hdwf.fe.solver import TOL_GAP, LevelSolution
@@ -421,7 +421,8 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
 
 
 def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int,
-                               variants: list[ModelChanges]) -> list[LostMotionResult]:
+                               variants: list[ModelChanges], shared: SharedBodies | None = None
+                               ) -> list[LostMotionResult]:
     """The test for several model variants of one design, sharing what they can.
 
     The bodies are assembled and factorised and the wave generator mounted once; each
@@ -433,14 +434,12 @@ def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_r
 
     Parameters
     ----------
-    geom : DriveGeometry
-        The design.
-    mesh : DriveMesh
-        Its mesh.
-    steps_per_ramp : int
-        Load steps per ramp.
+    geom, mesh, steps_per_ramp : DriveGeometry, DriveMesh, int
+        The design, its mesh and the load steps per ramp.
     variants : list of ModelChanges
         The model variants.
+    shared : SharedBodies, optional
+        Bodies built for earlier outlines of the design that the models may take.
 
     Returns
     -------
@@ -450,12 +449,12 @@ def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_r
     for ch in variants:
         _check_geometry(geom, ch)
     if geom.preloaded:
-        return _preloaded_variants(geom, mesh, steps_per_ramp, variants)
+        return _preloaded_variants(geom, mesh, steps_per_ramp, variants, shared)
     t0 = time.perf_counter()
     frac = torque_fractions(steps_per_ramp)
     base = None
     try:
-        base = LostMotionModel(geom, mesh)
+        base = LostMotionModel(geom, mesh, shared=shared)
         mounted = mount_wave_generator(base)
     except Exception as exc:
         failed = _failed(exc, base, t0)
@@ -477,7 +476,7 @@ def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_r
 
 
 def _preloaded_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int,
-                        variants: list[ModelChanges]) -> list[LostMotionResult]:
+                        variants: list[ModelChanges], shared: SharedBodies | None) -> list[LostMotionResult]:
     """Preloaded teeth are in from the mount on and the CS support changes the preload: each
     variant that changes the section mounts its own wave generator (friction ones too, though
     mounted without friction); variants differing only in series elements share it all."""
@@ -489,7 +488,7 @@ def _preloaded_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: in
         if key not in solved:
             model = None
             try:
-                model = LostMotionModel(geom, mesh, changes=key, zone_deg=_zone(geom, None))
+                model = LostMotionModel(geom, mesh, changes=key, zone_deg=_zone(geom, None), shared=shared)
                 mounted = mount_wave_generator(model, True)
                 solved[key] = (model, mounted, _torque_test(model, frac, mounted, None), None)
             except Exception as exc:   # any failure is reported, never a silent number

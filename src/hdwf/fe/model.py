@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import copy
 import math
-from dataclasses import fields, replace
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
@@ -21,6 +21,7 @@ from hdwf.fe.changes import ModelChanges
 from hdwf.fe.contact_rows import Rows, stack_rows
 from hdwf.fe.friction import flank_law
 from hdwf.fe.hertz import ball_compliance_coeff
+from hdwf.fe.node_columns import PATTERN_BODIES, NodeColumns
 from hdwf.fe.solver import TOL_GAP, ContactFailure, ContactSolver, LevelSolution, SolverSettings
 from hdwf.fe.structure import ModeName, Structure
 from hdwf.fe.working_set import WorkingSet
@@ -61,18 +62,45 @@ def with_flank_layer(geom: DriveGeometry, changes: ModelChanges) -> DriveGeometr
     return replace(geom, flank_layer_um_per_MPa=changes.layer_um_per_MPa(geom.module, geom.E))
 
 
+@dataclass
+class SharedBodies:
+    """Bodies assembled and factorised once for several models of one design.
+
+    A preload's allowance thickens the FS teeth and nothing else, so the variants of a design
+    with different allowances have the same CS and bearing rings (``hdwf.drive.mesh.share_bodies``
+    hands them the same body meshes).  A model given this object takes each body built from the
+    same body-mesh object, steel, symmetry and watched zones by an earlier model, with the
+    responses its nodes have had (``NodeColumns``: exact columns of K^-1), instead of building
+    its own; the CS only when it is clamped at its own size (no housing, no temperature change).
+    """
+
+    # (body, E, nu, half, zone) -> (the body mesh it was built from, the body, its node responses)
+    built: dict = field(default_factory=dict)
+
+    def take(self, name: str, bm: BodyMesh, key: tuple) -> tuple[Body, NodeColumns | None] | None:
+        """A copy of the body built from ``bm`` under ``key`` (its watch numbering its own), or None."""
+        hit = self.built.get((name, *key))
+        if hit is None or hit[0] is not bm:
+            return None
+        return copy.copy(hit[1]), hit[2]
+
+    def keep(self, name: str, bm: BodyMesh, key: tuple, body: Body, columns: NodeColumns | None) -> None:
+        self.built[(name, *key)] = (bm, body, columns)
+
+
 class LostMotionModel:
     """Holds the factorised bodies, the contact rows and the contact solver's state.
 
     ``geom``, ``mesh``, ``E``, ``max_iter``, ``tol_gap`` and ``changes`` are those of
     ``solve_lost_motion``; ``zone_deg`` is the half width (deg) of the tooth engagement zones
     about the major axis whose nodes are watched, ``n_bins`` the number of OR / FS fit bins
-    over the circle.
+    over the circle; ``shared`` the bodies it may take from earlier models (``SharedBodies``).
     """
 
     def __init__(self, geom: DriveGeometry, mesh: DriveMesh, E: float | None = None,
                  max_iter: int = 200, tol_gap: float = TOL_GAP, zone_deg: float = ZONE_DEG,
-                 n_bins: int = 360, changes: ModelChanges | None = None):
+                 n_bins: int = 360, changes: ModelChanges | None = None,
+                 shared: SharedBodies | None = None):
         self.changes = ModelChanges() if changes is None else changes
         self._plain_geometry = geom
         self.geometry = with_flank_layer(geom, self.changes)
@@ -85,7 +113,14 @@ class LostMotionModel:
         self._cs_mesh, self._cs_watch = body_meshes["cs"], watch["cs"]
         self.factorize_s = 0.0
         bodies: dict[str, Body] = {}
+        key = (self.material.E, self.material.nu, self.half, zone_deg)
+        plain_cs = math.isinf(self.changes.cs_rim_stiffness_N_mm2) and self.changes.cs_scale == 1.0
+        taken: dict[str, NodeColumns | None] = {}
         for name in ("fs", "cs", "ir", "or"):
+            hit = shared.take(name, body_meshes[name], key) if shared and (name != "cs" or plain_cs) else None
+            if hit is not None:
+                bodies[name], taken[name] = hit
+                continue
             if name == "cs":
                 body, seconds = self._build_cs(self.changes)
             else:
@@ -94,6 +129,13 @@ class LostMotionModel:
             self.factorize_s += seconds
             bodies[name] = body
         self.structure = Structure(bodies, self.half, geom.r_fs_root)
+        for name, columns in taken.items():
+            if columns is not None:
+                self.structure.adopt_node_columns(name, columns)
+        if shared is not None:
+            for name in set(bodies) - set(taken) - ({"cs"} if not plain_cs else set()):
+                columns = self.structure.node_columns(name) if name in PATTERN_BODIES else None
+                shared.keep(name, body_meshes[name], key, bodies[name], columns)
         self.rows: dict[str, Rows] = {}
         self.mode_list: list[ModeName] = []     # free rigid modes of the current stage
         nwatch = self.structure.nwatch

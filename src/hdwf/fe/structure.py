@@ -163,6 +163,16 @@ class Structure:
             self._node_cache[name] = NodeColumns(2 * body.watch_nodes.size)
         return self._node_cache[name]
 
+    def node_columns(self, name: str) -> NodeColumns:
+        """The responses kept for loads on the nodes of body ``name``."""
+        return self._node_columns(name, self.bodies[name])
+
+    def adopt_node_columns(self, name: str, columns: NodeColumns) -> None:
+        """Keep the node responses of body ``name`` in ``columns``, those of another structure
+        with the same body (same factorisation and watch nodes): they are on the body's own
+        watch dofs, whatever its place in either watch vector."""
+        self._node_cache[name] = columns
+
     def _node_response(self, name: str, loads: list[tuple[np.ndarray, np.ndarray]]
                        ) -> tuple[np.ndarray, np.ndarray]:
         """``_watch_response`` to loads (the body's watch dofs, values) on body ``name``."""

@@ -9,7 +9,9 @@ A *table* holds the solved curves of a specimen's variants, one row per load ste
 Reuse between candidates (what makes a campaign affordable):
 
 * one mesh per specimen, built once and shared by every variant of that specimen (a variant
-  that reshapes the section, a preload, gets a mesh of its own, shared by its variants);
+  that reshapes the section, a preload, gets a mesh of its own, shared by its variants; the
+  allowances of a specimen differ in the FS teeth only, so their outlines mesh only the FS
+  anew and share the CS and bearing rings, assembled and factorised once: ``SharedBodies``);
 * one assembly and factorisation of the bodies and one wave-generator stage per specimen:
   every effect acts only once the teeth engage (``hdwf.fe.solve_lost_motion_variants``),
   so each variant costs only its torque sequence (and the housing a new CS factorisation);
@@ -29,7 +31,7 @@ import os
 import sys
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable, Mapping
 
 import numpy as np
@@ -38,8 +40,10 @@ from tqdm import tqdm
 
 from hdwf import PARAMETER_COLUMNS
 from hdwf.drive.design import MeshSettings, geometry_of
-from hdwf.drive.geometry import ARCMIN
+from hdwf.drive.geometry import ARCMIN, DriveGeometry
+from hdwf.drive.mesh import share_bodies
 from hdwf.fe import ModelChanges, series_output_twist, solve_lost_motion_variants
+from hdwf.fe.model import SharedBodies
 from hdwf.validation.effects import get as get_effect
 from hdwf.validation.effects import model_changes, registry
 
@@ -179,10 +183,16 @@ def solve_specimen(setup: SolveSetup, specimen: Mapping, variants: list[dict]) -
     outlines: dict[tuple, list[ModelChanges]] = {}
     for part in parts:
         outlines.setdefault(tuple(sorted(part.geometry_part().items())), []).append(part)
-    solved = {}
+    solved, first_preloaded, shared = {}, None, SharedBodies()
     for outline, group in outlines.items():
         geom = geometry_of(setup.unit, params, **dict(outline))
-        solved.update(zip(group, solve_lost_motion_variants(geom, settings.mesh(geom), steps, group)))
+        if first_preloaded is not None and _fs_only_differs(geom, first_preloaded[0]):
+            mesh = share_bodies(settings.mesh(geom, bodies=("fs",)), first_preloaded[1])
+        else:
+            mesh = settings.mesh(geom)
+            if geom.interference_m > 0 and first_preloaded is None:
+                first_preloaded = (geom, mesh)
+        solved.update(zip(group, solve_lost_motion_variants(geom, mesh, steps, group, shared)))
     frames = []
     for eff, ch in zip(variants, changes):
         res = solved[ch.fe_part()]
@@ -201,6 +211,12 @@ def solve_specimen(setup: SolveSetup, specimen: Mapping, variants: list[dict]) -
             "status": "ok" if ok else f"failed: {res.reason}",
             "ball_pressure_max_MPa": float(res.max_ball_pressure_MPa) if ok else np.nan}))
     return pd.concat(frames, ignore_index=True)[TABLE_COLUMNS]
+
+
+def _fs_only_differs(geom: DriveGeometry, other: DriveGeometry) -> bool:
+    """Whether two outlines of a specimen differ in the FS flank allowance only (which thickens
+    the FS teeth and nothing else: ``DriveGeometry.interference``)."""
+    return replace(other, interference_m=geom.interference_m) == geom
 
 
 def _specimen_job(task: tuple[SolveSetup, dict, list[dict]]) -> pd.DataFrame:
