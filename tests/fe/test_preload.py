@@ -287,6 +287,46 @@ def test_flank_friction_is_switched_on_at_the_assembled_preload():
 
 
 @pytest.mark.slow
+def test_friction_variants_share_the_frictionless_mount(monkeypatch):
+    """Friction acts only from the assembled state on, so variants of a preloaded design that
+    differ in their flank friction only are solved on forks of one frictionless mount, each
+    with its friction switched on there: the same numbers as each variant mounted on its own
+    (to round-off), and one wave-generator mount instead of one per friction value."""
+    from hdwf.fe import ModelChanges, solve_lost_motion_variants
+    from hdwf.fe import cycle
+
+    g = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.005, 0.005, interference_m=0.1, tip_relief=1.1)
+    mesh = build_mesh(g, **COARSE, symmetry="half")
+    variants = [ModelChanges(flank_interference_m=0.1, flank_friction=mu) for mu in (0.0, 0.05, 0.1)]
+    mounts = []
+    real_mount = cycle.mount_wave_generator
+
+    def counting_mount(model, ramp_teeth=False):
+        mounts.append(model.changes)
+        return real_mount(model, ramp_teeth)
+    monkeypatch.setattr(cycle, "mount_wave_generator", counting_mount)
+    together = solve_lost_motion_variants(g, mesh, 1, variants)
+    monkeypatch.undo()
+    assert mounts == [ModelChanges(flank_interference_m=0.1)]
+    for ch, r in zip(variants, together):
+        alone = solve_lost_motion(g, mesh, steps_per_ramp=1, changes=ch)
+        assert r.status == alone.status == "ok", (r.reason, alone.reason)
+        np.testing.assert_allclose(r.twist_arcmin, alone.twist_arcmin, rtol=0, atol=1e-9)
+    assert together[2].lost_motion_arcmin < together[0].lost_motion_arcmin - 0.01   # sticking flanks
+
+
+def test_friction_is_the_only_change_a_mount_can_take_on():
+    """``with_flank_friction`` switches friction on at a mounted state; a variant that differs
+    in anything else needs its own mount, and asking for it is an error, not a silent reuse."""
+    from types import SimpleNamespace
+
+    from hdwf.fe import ModelChanges
+    mounted = SimpleNamespace(changes=ModelChanges(flank_interference_m=0.1))
+    with pytest.raises(ValueError, match="more than its flank friction"):
+        preload.with_flank_friction(mounted, None, ModelChanges(flank_interference_m=0.15, flank_friction=0.1))
+
+
+@pytest.mark.slow
 def test_a_reused_level_leaves_the_warm_start_the_solved_one_left():
     """A level reused on the way back must hand the next level the warm start (displacement,
     ball secants) it left when it was solved, not that of the last level solved (+T).  From

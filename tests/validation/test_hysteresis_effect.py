@@ -29,7 +29,7 @@ from hdwf.fe import (
     solve_lost_motion_variants,
     torque_fractions,
 )
-from hdwf.fe.cycle import microslip_twist
+from hdwf.fe.series import microslip_twist
 from hdwf.validation.effects import get, model_changes
 from hdwf.validation.variants import SolveSetup, solve_specimen, variant_key
 

@@ -20,6 +20,7 @@ Phi = phi + phi'.  The modules, from the bottom up:
 * ``preload``: the preload ramp that mounts preloaded teeth (``DriveGeometry.preloaded``: a flank
   allowance ``interference_m`` or a deeper cam ``deflection_coeff``), and the
   check of the teeth outside the watched zones;
+* ``series``: elements in series between the FS rim and the output (spring, dead band, micro-slip);
 * ``cycle``: the test itself, ``solve_lost_motion`` and ``solve_lost_motion_variants``.
 
 Half model (``mesh.symmetry == "half"``, hand-written): the drive and its load are
@@ -40,11 +41,12 @@ a temperature difference and Oldham play are off in the baseline (``ModelChanges
 
 from hdwf.fe.bodies import assemble_stiffness, edge_loads, plane_stress_lame, solve_linear
 from hdwf.fe.changes import ModelChanges
-from hdwf.fe.cycle import (LostMotionResult, series_output_twist, solve_lost_motion,
+from hdwf.fe.cycle import (LostMotionResult, solve_lost_motion,
                            solve_lost_motion_variants, torque_fractions)
 from hdwf.fe.hertz import (ISO76_BALL_PRESSURE_MPA, ball_compliance_coeff, ball_max_pressure,
                             hertz_max_pressure, hertz_point_contact)
 from hdwf.fe.model import LostMotionModel
+from hdwf.fe.series import series_output_twist
 from hdwf.fe.solver import ContactFailure
 
 __all__ = ["ISO76_BALL_PRESSURE_MPA", "ContactFailure", "LostMotionModel", "LostMotionResult", "ModelChanges",

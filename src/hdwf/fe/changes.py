@@ -39,7 +39,7 @@ class ModelChanges:
       lost-motion test 0 -> +T -> 0 -> -T -> 0.  It is the Iwan/Masing element (springs
       bridged by Coulomb sliders, the compliance spread evenly over their slip torques) of
       density a = 2 w / T^2, T the peak torque of the path (the test torque); its twist
-      follows the load path with the Masing rule (``hdwf.fe.cycle.microslip_twist``).
+      follows the load path with the Masing rule (``hdwf.fe.series.microslip_twist``).
     * ``flank_interference_m``: preloaded engagement, the FS teeth thicker by this many modules
       on each flank (``DriveGeometry.interference_m``), their tips relieved as a preload needs
       (``hdwf.drive.relief.PRELOAD_TIP_RELIEF``). It changes the section's outline, so the

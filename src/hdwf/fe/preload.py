@@ -21,12 +21,14 @@ changed.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
 from hdwf.fe.contact_geometry import boundary_edge_normals, closest_segments
 from hdwf.fe.contact_rows import tooth_rows
-from hdwf.fe.friction import FlankFriction, NoFriction
+from hdwf.fe.changes import ModelChanges
+from hdwf.fe.friction import FlankFriction, NoFriction, flank_law
 from hdwf.fe.model import LostMotionModel
 from hdwf.fe.relinearise import GEO_MAX_IT, GEO_TOL, held_back, penetration, settle
 from hdwf.fe.solver import ContactFailure, LevelSolution
@@ -120,12 +122,30 @@ def mount_with_cutback(model: LostMotionModel, level: LevelSolution) -> tuple[Le
     except Exception:
         model.solver.friction = law      # the model as it came, friction and all
         raise
-    if isinstance(law, FlankFriction):
-        model.solver.friction = FlankFriction.sticking_at(law.mu, model.structure, model.rows, model.solver.working_set,
-                                                          mounted.pair_ids, mounted.normal_force)
-    else:
-        model.solver.friction = law
+    model.solver.friction = _switched_on(law, model, mounted)
     return mounted, info
+
+
+def _switched_on(law, model: LostMotionModel, mounted: LevelSolution):
+    """The flank law ``law`` at the mounted state: friction with the loaded flanks sticking."""
+    if isinstance(law, FlankFriction):
+        return FlankFriction.sticking_at(law.mu, model.structure, model.rows, model.solver.working_set,
+                                         mounted.pair_ids, mounted.normal_force)
+    return law
+
+
+def with_flank_friction(mounted_model: LostMotionModel, mounted: LevelSolution,
+                        changes: ModelChanges) -> LostMotionModel:
+    """A fork of a model mounted without friction, with the flank friction of ``changes``
+    switched on at its mounted state as ``mount_with_cutback`` does it: the mount of variants
+    that differ only in their flank friction is one and the same (frictionless) mount."""
+    if replace(mounted_model.changes, flank_friction=changes.flank_friction) != changes:
+        raise ValueError("with_flank_friction: the variant differs from the mounted model in more "
+                         "than its flank friction")
+    model = mounted_model.fork()
+    model.changes = changes
+    model.solver.friction = _switched_on(flank_law(changes.flank_friction, model.nwatch), model, mounted)
+    return model
 
 
 def _ramp_with_cutback(model: LostMotionModel, level: LevelSolution) -> tuple[LevelSolution, dict]:
