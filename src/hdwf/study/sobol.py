@@ -4,7 +4,10 @@ Estimates follow SALib's sample/analyze split: the base sample (LHS, Halton or S
 from ``hdwf.study.doe``) of dimension 2k gives the matrices A and B, the radial matrices AB_i
 are built in SALib's row order (A, AB_1..AB_k, B per base point) and
 ``SALib.analyze.sobol.analyze`` returns S1 and ST (Saltelli 2010 / Jansen estimators) with
-bootstrap confidence intervals.  The exact indices of a quadratic come from its Legendre
+bootstrap confidence intervals.  SALib draws all its resamples at once, N x resamples copies of
+the sample (1.8 GB at N = 262 144 and 100 resamples), so the bootstrap is asked of it in chunks of
+``BOOTSTRAP_CHUNK`` resamples, each kept (``keep_resamples``), and the half-width is SALib's
+z · std over all of them.  The exact indices of a quadratic come from its Legendre
 expansion (background §5, Sudret 2008) and are the value the estimates converge to.
 """
 
@@ -15,11 +18,13 @@ from itertools import combinations
 import numpy as np
 import pandas as pd
 from SALib.analyze import sobol as salib_sobol
+from scipy.stats import norm
 
 from hdwf.study.doe import unit_sample
 from hdwf.study.surrogate import QuadraticSurrogate
 
 SOBOL_COLUMNS = ["parameter", "sampler", "n", "S1", "S1_conf", "ST", "ST_conf"]
+BOOTSTRAP_CHUNK = 20   # resamples per SALib call (its memory grows with N x resamples)
 
 
 def exact_quadratic_indices(coef_linear, coef_square, coef_interaction) -> tuple[np.ndarray, np.ndarray]:
@@ -77,11 +82,28 @@ def estimate_indices(model_unit, parameters: list[str], sampler: str, n: int, se
     base = unit_sample(sampler, n, 2 * k, seed)
     y = np.asarray(model_unit(radial_matrix(base)), float)
     problem = {"num_vars": k, "names": list(parameters), "bounds": [[0.0, 1.0]] * k}
-    res = salib_sobol.analyze(problem, y, calc_second_order=False, num_resamples=num_resamples,
-                              conf_level=conf_level, seed=seed)
-    return pd.DataFrame({"parameter": parameters, "sampler": sampler, "n": n, "S1": res["S1"],
-                         "S1_conf": res["S1_conf"], "ST": res["ST"], "ST_conf": res["ST_conf"]},
+    runs = [salib_sobol.analyze(problem, y, calc_second_order=False, num_resamples=size, conf_level=conf_level,
+                                seed=seed + 7919 * i, keep_resamples=True)   # (SALib: seed 0 = unseeded)
+            for i, size in enumerate(_chunks(num_resamples))]
+    z = norm.ppf(0.5 + conf_level / 2.0)
+    half = {name: z * np.vstack([r[f"{name}_conf_all"] for r in runs]).std(axis=0, ddof=1)
+            for name in ("S1", "ST")}
+    return pd.DataFrame({"parameter": parameters, "sampler": sampler, "n": n, "S1": runs[0]["S1"],
+                         "S1_conf": half["S1"], "ST": runs[0]["ST"], "ST_conf": half["ST"]},
                         columns=SOBOL_COLUMNS)
+
+
+def _chunks(num_resamples: int) -> list[int]:
+    """``num_resamples`` split into SALib calls of at most ``BOOTSTRAP_CHUNK`` (each >= 2)."""
+    if num_resamples < 2:
+        raise ValueError(f"num_resamples must be >= 2 (a standard deviation), not {num_resamples}")
+    sizes = [BOOTSTRAP_CHUNK] * (num_resamples // BOOTSTRAP_CHUNK)
+    rest = num_resamples - sum(sizes)
+    if rest == 1:
+        sizes[-1] += 1
+    elif rest:
+        sizes.append(rest)
+    return sizes
 
 
 def convergence(model_unit, parameters: list[str], sampler: str, *, n_start: int = 64, n_min: int = 65536,
