@@ -192,7 +192,9 @@ def solve_specimen(setup: SolveSetup, specimen: Mapping, variants: list[dict]) -
             mesh = settings.mesh(geom)
             if geom.interference_m > 0 and first_preloaded is None:
                 first_preloaded = (geom, mesh)
-        solved.update(zip(group, solve_lost_motion_variants(geom, mesh, steps, group, shared)))
+        # only allowances share bodies (the bare outline's CS has no relief): keep none of its
+        solved.update(zip(group, solve_lost_motion_variants(geom, mesh, steps, group,
+                                                            shared if geom.interference_m > 0 else None)))
     frames = []
     for eff, ch in zip(variants, changes):
         res = solved[ch.fe_part()]
