@@ -4,8 +4,8 @@ Meshes the design of ``--designs`` (a study's ``designs.parquet``, e.g. the defa
 ``results/fe/hd42/designs.parquet``) at each ``--refinements`` factor of ``--mesh`` elements
 over the tooth height x thickness (default 10x6, the studies'; half model, 5 steps per ramp),
 solves it with ``--effects`` switched on (default: the ``fe.effects`` of ``config.yaml``) and
-appends one row per mesh to ``--out`` (CSV: design, mesh, refinement, nodes, status, Φ, φ+, φ−,
-teeth in contact, seconds).  ``--mesh 20x6`` refines the teeth (their size is the finer
+appends one row per mesh to ``--out`` (CSV: design, mesh, refinement, effects, zone, nodes, status,
+Φ, φ+, φ−, teeth in contact, overlap left outside the zones, seconds).  ``--mesh 20x6`` refines the teeth (their size is the finer
 of height / 20 and thickness / 6) and what grades from them (the FS rim, the CS rim where four
 tooth sizes decide), not the bearing rings.  ``--zone 45`` solves the contacts of the teeth within
 45 deg of a major axis only (default: every tooth, as a preload needs) and records the overlap
