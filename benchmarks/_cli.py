@@ -10,7 +10,8 @@ from hdwf import PARAMETER_COLUMNS
 
 
 def add_shape_arguments(ap: argparse.ArgumentParser) -> None:
-    """--deflection, --addendum-frac and --offsets (docs/fe-model.md, "The studies' model")."""
+    """--deflection, --addendum-frac and --offsets (docs/fe-alternatives.md, "A deeper cam" and
+    "Reading r_FS, r_CS as rack shifts")."""
     ap.add_argument("--deflection", type=float, default=1.0,
                     help="DriveGeometry.deflection_coeff: the cam pushes this many w0 (> 1: a deeper cam)")
     ap.add_argument("--addendum-frac", type=float, default=None,

@@ -13,7 +13,7 @@ sit at +T: force and pair count per 0.1 m band (``band_m``) of the slave node's 
 minus the CS tip radius (0: on the CS tip's edge; the CS root is about 1.9 m deeper).
 It hooks ``hdwf.fe.cycle``'s mount and ±T settling while it runs to read their contact states.
 
-Example (docs/fe-model.md, "The studies' model"):
+Example (docs/fe-alternatives.md, "The allowance alone as the studies' model"):
   OMP_NUM_THREADS=1 python benchmarks/bench_mount_forces.py --unit hd42 \\
       --designs results/fe/hd42/designs.parquet --design hd42-lhs-23 --preload 0,0.05,0.1,0.157 --bands
   ... --design hd42-lhs-23 --preload 0.157 --depth --out depth.csv

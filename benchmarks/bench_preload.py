@@ -18,7 +18,7 @@ with every tooth watched at every interference.  The summary adds Phi's range, R
 Pearson correlation ours vs paper) and the paper's dPhi/dr_FS on the same designs.
 ``--summary-only`` re-reads ``--out`` and prints the summary.
 ``--deflection 1.4 --addendum-frac 0.38 --interference 0`` solves the other preload, a deeper
-cam (``DriveGeometry.deflection_coeff``; docs/fe-model.md, "A deeper cam instead");
+cam (``DriveGeometry.deflection_coeff``; docs/fe-alternatives.md, "A deeper cam");
 ``--offsets radial`` reads r_FS, r_CS as rack shifts (``DriveGeometry.offset_direction``).
 ``--flank-layer 1167,2333`` solves each interference with a compliant flank layer of each
 thickness (modules; effect ``flank_layer``, docs/fe-model.md, "A compliant flank layer").

@@ -7,7 +7,7 @@ teeth in contact at +T. A diagnostic: it swaps ``hdwf.fe.model.make_body`` and
 ``ball_compliance_coeff`` for scaled versions while it runs; the library has no such option.
 A stiffer ring also resists the cam's ovalisation, so compare only runs whose push agrees.
 
-Example (docs/fe-model.md, "What the hump is made of"):
+Example (docs/fe-alternatives.md, "A deeper cam", what the hump is made of):
   OMP_NUM_THREADS=1 python benchmarks/bench_stiffen.py --unit hd42 --base rFS_mm=0.008,rCS_mm=0 \\
       --deflection 1.4 --addendum-frac 0.38
 """

@@ -10,7 +10,7 @@ axis: beyond about 45 deg a tip crossing in the exit zone). ``--out`` appends th
 (``DriveGeometry.deflection_coeff``), instead of or with the flank allowance; ``--offsets radial``
 reads r_FS, r_CS as rack shifts (``DriveGeometry.offset_direction``).
 
-Example (docs/fe-model.md, "Where the torque is carried"):
+Example (docs/fe-alternatives.md, "Where the torque is carried"):
   OMP_NUM_THREADS=1 python benchmarks/bench_sweep.py --unit hd42 --base rFS_mm=0.016,rCS_mm=0.016 \\
       --vary d_mm=31.0,31.004,31.008,31.012,31.016 --preload 0.157
 """

@@ -113,9 +113,9 @@ def test_loaded_arc_shows_where_the_torque_is_carried():
     (a few teeth within 20°); HD 42's loosest bearing of Table 3 (d, D, G_r at their clearance
     bounds) with zero offsets and a heavy allowance pushes the FS so far back that teeth all
     round, out to the minor axis, are loaded: the exit-zone tip crossings the diagnostic is
-    there to show (docs/fe-model.md, "The studies' model").  The tight design's preload loads
-    its most loaded wave-generator ball beyond ISO 76's static rating (4200 MPa); the open one's
-    balls carry only the FS ring's bending, tens of newtons."""
+    there to show (docs/fe-alternatives.md, "Where the torque is carried").  The tight design's
+    preload loads its most loaded wave-generator ball beyond ISO 76's static rating (4200 MPa);
+    the open one's balls carry only the FS ring's bending, tens of newtons."""
     g_open = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.02, 0.02, interference_m=0.17,
                             tip_relief=PRELOAD_TIP_RELIEF)
     r_open = solve_lost_motion(g_open, build_mesh(g_open, **COARSE), steps_per_ramp=1)

@@ -155,7 +155,8 @@ def _where_it_misses(conv: pd.DataFrame) -> str:
     said = (f"; the {len(miss)} that miss by more have median $Phi$ {fmt(miss.median(), 3)} arcmin (largest "
             f"{fmt(miss.max(), 3)}), the converged ones {fmt(ok.median(), 3)} arcmin")
     if miss.median() < ok.median():
-        said += (": the misses are at the smaller $Phi$, and docs/fe-model.md (Mesh convergence) traces a locked "
+        said += (": the misses are at the smaller $Phi$, and docs/fe-alternatives.md (Mesh-convergence "
+                 "experiments) traces a locked "
                  "design's $Phi$ to preloaded flank contacts carried by one or two nodes each")
     return said
 
@@ -187,7 +188,7 @@ def _ball_load(lm: pd.DataFrame) -> str:
     return (text + f"; in {int(over.sum())} of {len(lm)} designs above the {ISO76_BALL_PRESSURE_MPA:g} MPa of "
             "the static rating of ISO 76, where the raceways dent: a drive preloaded that hard would be damaged at "
             "assembly, so the allowance cannot be read as a real interference of the drive "
-            "(docs/fe-model.md, \"The studies' model\"). ")
+            "(docs/fe-model.md, \"Preloaded engagement\"). ")
 
 
 
@@ -203,7 +204,7 @@ def _exit_zone_load(lm: pd.DataFrame) -> str:
             f"carry load at +T (out to {fmt(arc.max(), 1)}°): relieved tips still crossing on the way out of "
             "mesh, from the uniform preload allowance. The paper reports tooth interference in its own model "
             "too, near the minor axis and 60° from it; a deeper cam that engages the major axis only "
-            "matches HD 120 but not HD 42 (docs/fe-model.md, \"The studies' model\"). ")
+            "matches HD 120 but not HD 42 (docs/fe-alternatives.md, \"A deeper cam\"). ")
 
 
 def _unsolved_overlap(lm: pd.DataFrame) -> str:
