@@ -180,7 +180,11 @@ def agreement_figure(pairs: dict[str, tuple[np.ndarray, np.ndarray]], title: str
         ax.plot(paper[ok], ours[ok], "o", mfc="none")
         slope, icpt = np.polyfit(paper[ok], ours[ok], 1)
         xs = np.linspace(paper.min(), paper.max(), 20)
-        ax.plot(xs, icpt + slope * xs, "-", color="tab:red", lw=1, label=f"fit: ours = {slope:.2f}·paper + {icpt:.2f}")
+        sign = "−" if icpt < 0 else "+"
+        ax.plot(xs, icpt + slope * xs, "-", color="tab:red", lw=1,
+                label=f"fit: ours = {slope:.2f}·paper {sign} {abs(icpt):.2f}")
+        # the level is read against equality, which the fit alone does not show
+        ax.plot(xs, xs, "--", color="0.4", lw=1, label="ours = paper")
         ax.set_xlabel("paper's Ansys FEA Φ (arcmin)")
         ax.set_ylabel("hdwf FE Φ (arcmin)")
         ax.set_title(label, fontsize=10)
