@@ -6,7 +6,8 @@ out of the CS spaces, the FS turned at +-T) has to be solved again with rows tha
 or its gaps are off by fractions of a micrometre.  With preloaded teeth that is not small:
 the twist at +-T is the difference of the interference and the elastic retreat of the FS,
 and a single re-linearisation at +T made Phi path-dependent (the way back to zero did not
-return to the start) and jump from mesh to mesh (``docs/fe-model.md``).
+return to the start) and jump from mesh to mesh (``docs/fe-alternatives.md``, "Mesh-convergence
+experiments").
 
 ``settle`` is the fixed point: at a solved level the rows of every pair near contact are
 re-detected (nonlinear gap) and compared with their linearisation; while the error is above
