@@ -156,8 +156,8 @@ def _where_it_misses(conv: pd.DataFrame) -> str:
             f"{fmt(miss.max(), 3)}), the converged ones {fmt(ok.median(), 3)} arcmin")
     if miss.median() < ok.median():
         said += (": the misses are at the smaller $Phi$, and docs/fe-alternatives.md (Mesh-convergence "
-                 "experiments) traces a locked "
-                 "design's $Phi$ to preloaded flank contacts carried by one or two nodes each")
+                 "experiments) traces a locked design's $Phi$ to preloaded flank contacts carried by one or two "
+                 "nodes each")
     return said
 
 
