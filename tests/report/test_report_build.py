@@ -160,6 +160,39 @@ def test_agreement_section_labels_the_blind_drive_and_its_misses(named_inputs, t
     assert said in text and "preloaded" in text.lower() and "0.147" in text
 
 
+def test_agreement_section_gives_the_band_under_the_measured_mesh_scatter(named_inputs, tmp_path):
+    """With a convergence table for the drive, a second table gives each figure's 5–95 % band when
+    our Φ moves by the measured mesh changes: with ours = 1.2 × the paper's and changes far too small
+    to swap two of Table 4's designs (< 0.05 %), rank stays 1 and the ratio 1.2 ± 0.05 %; a missing
+    table leaves the band out."""
+    import dataclasses
+
+    import pandas as pd
+
+    from hdwf.report.fe_part import agreement_section
+
+    paper = study_artefacts("paper", STUDY, artefacts_by_owner(*named_inputs))
+    table = pd.read_parquet(paper.drive("hd42").lost_motion)
+    gaps = table["lost_motion_arcmin"].sort_values().pct_change().dropna()
+    assert gaps.min() > 2 * 5e-4  # so the changes below cannot reorder the designs
+    table["lost_motion_arcmin"] *= 1.2
+    table.to_parquet(tmp_path / "scaled.parquet")
+    ours = dataclasses.replace(paper, name="fe_at_paper", source="fe",
+                               drives=(dataclasses.replace(paper.drive("hd42"), lost_motion=tmp_path / "scaled.parquet"),))
+    pd.DataFrame({"design_id": ["a", "b", "c"], "rel_change_fine": [1e-4, -5e-4, 2e-4]}).to_parquet(tmp_path / "conv.parquet")
+    doc = Document("t", "s", PROVENANCE)
+    agreement_section(doc, ["hd42"], paper, ours, tmp_path, mesh_changes={"hd42": tmp_path / "conv.parquet"})
+    tables = [b for b in doc.blocks if b["type"] == "table"]
+    assert len(tables) == 2
+    name, changes, ratio, rho, r2 = tables[1]["rows"][0]
+    assert name == "HD 42" and changes == "2.0e-02 %, 5.0e-02 %" and rho == "1.000–1.000" and r2 == "1.000–1.000"
+    lo, hi = (float(v) for v in ratio.split("–"))
+    assert 1.2 * (1 - 5e-4) <= lo <= hi <= 1.2 * (1 + 5e-4)
+    doc = Document("t", "s", PROVENANCE)
+    agreement_section(doc, ["hd42"], paper, ours, tmp_path, mesh_changes={})
+    assert len([b for b in doc.blocks if b["type"] == "table"]) == 1
+
+
 def test_ball_load_sentence_holds_the_mount_against_iso_76():
     """The FE part states the most loaded wave-generator ball against ISO 76's 4200 MPa, and counts
     the designs above it; a study without the columns (an older run) says nothing."""

@@ -1,0 +1,74 @@
+"""Agreement of ours with the paper's Φ, and its band under mesh scatter: against cases with known answers."""
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from hdwf.study.agreement import agreement, agreement_under_mesh_scatter
+
+PAPER = np.array([0.34, 0.19, 0.33, 1.09, 0.25, 0.51, 0.71, 1.49, 0.22, 0.40, 0.95, 0.28])
+
+
+def test_agreement_is_scipys_spearman_and_pearson_squared_and_the_median_ratio():
+    ours = PAPER * np.linspace(0.8, 1.3, PAPER.size) + 0.02 * np.sin(np.arange(PAPER.size))
+    a = agreement(PAPER, ours)
+    assert a.n == PAPER.size
+    assert a.spearman == pytest.approx(stats.spearmanr(PAPER, ours).statistic, abs=1e-12)
+    assert a.r2 == pytest.approx(stats.pearsonr(PAPER, ours).statistic ** 2, abs=1e-12)
+    assert a.median_ratio == pytest.approx(np.median(ours / PAPER), abs=1e-12)
+
+
+def test_a_proportional_model_agrees_exactly_in_rank_and_shape():
+    a = agreement(PAPER, 2.5 * PAPER)
+    assert (a.median_ratio, a.spearman, a.r2) == pytest.approx((2.5, 1.0, 1.0), abs=1e-12)
+
+
+def test_designs_missing_either_value_are_left_out():
+    ours = 2.0 * PAPER
+    ours[3] = np.nan
+    a = agreement(PAPER, ours)
+    assert a.n == PAPER.size - 1 and a.spearman == pytest.approx(1.0)
+
+
+def test_no_mesh_change_collapses_the_band_onto_the_figures():
+    ours = PAPER * np.linspace(0.7, 1.4, PAPER.size)
+    a, b = agreement(PAPER, ours), agreement_under_mesh_scatter(PAPER, ours, [0.0, 0.0])
+    for (lo, hi), point in ((b.median_ratio, a.median_ratio), (b.spearman, a.spearman), (b.r2, a.r2)):
+        assert lo == pytest.approx(point, abs=1e-12) and hi == pytest.approx(point, abs=1e-12)
+
+
+def test_changes_too_small_to_reorder_leave_the_rank_at_one():
+    # sorted neighbours differ by >= 10 %, so a change of at most 4 % each cannot swap two ranks
+    paper = 0.2 * 1.1 ** np.arange(15)
+    b = agreement_under_mesh_scatter(paper, 3.0 * paper, [0.04, 0.01, 0.03])
+    assert b.spearman == (1.0, 1.0)
+    assert 3.0 * 0.96 <= b.median_ratio[0] < b.median_ratio[1] <= 3.0 * 1.04
+    assert b.r2[1] <= 1.0 and b.r2[0] > 0.99
+
+
+def test_rank_and_shape_bands_do_not_depend_on_our_scale_and_the_ratio_band_scales():
+    ours = PAPER * np.linspace(0.7, 1.4, PAPER.size)
+    changes = [0.01, 0.02, 0.05, 0.15]
+    b1 = agreement_under_mesh_scatter(PAPER, ours, changes, seed=7)
+    b2 = agreement_under_mesh_scatter(PAPER, 4.0 * ours, changes, seed=7)
+    assert b2.spearman == pytest.approx(b1.spearman, abs=1e-12)
+    assert b2.r2 == pytest.approx(b1.r2, abs=1e-12)
+    assert b2.median_ratio == pytest.approx(tuple(4.0 * v for v in b1.median_ratio), rel=1e-12)
+
+
+def test_larger_scatter_widens_the_band_and_the_same_seed_repeats_it():
+    ours = PAPER * np.linspace(0.7, 1.4, PAPER.size)
+    small = agreement_under_mesh_scatter(PAPER, ours, [0.01])
+    large = agreement_under_mesh_scatter(PAPER, ours, [0.2])
+    assert np.ptp(large.r2) > np.ptp(small.r2) and np.ptp(large.spearman) > np.ptp(small.spearman)
+    assert agreement_under_mesh_scatter(PAPER, ours, [0.2]) == large
+
+
+@pytest.mark.parametrize("paper, ours, changes, match", [
+    (PAPER, PAPER[:-1], [0.01], "one length"),
+    (PAPER[:2], PAPER[:2], [0.01], "at least 3"),
+    (PAPER, PAPER, [np.nan], "no measured mesh change"),
+])
+def test_bad_input_is_refused_with_what_is_wrong(paper, ours, changes, match):
+    with pytest.raises(ValueError, match=match):
+        agreement_under_mesh_scatter(paper, ours, changes)
