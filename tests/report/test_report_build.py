@@ -193,6 +193,19 @@ def test_agreement_section_gives_the_band_under_the_measured_mesh_scatter(named_
     assert len([b for b in doc.blocks if b["type"] == "table"]) == 1
 
 
+def test_a_miss_whose_target_lies_in_the_mesh_band_says_so():
+    from hdwf.report.fe_part import _misses
+    from hdwf.study.agreement import Agreement, ScatterBand
+
+    a = Agreement(n=27, median_ratio=0.52, spearman=0.886, spearman_p=1e-9, r2=0.75)
+    band = ScatterBand(q=(0.05, 0.95), draws=2000, median_ratio=(0.51, 0.54), spearman=(0.869, 0.905), r2=(0.70, 0.78))
+    said = _misses("HD 120", a, band)
+    assert said == ["HD 120: median ratio 0.52 outside [0.67, 1.5]",
+                    "HD 120: Spearman 0.8860 < 0.9 (within its mesh-scatter band)",
+                    "HD 120: $R^2$ 0.7500 < 0.8"]
+    assert _misses("HD 120", a) == [m.replace(" (within its mesh-scatter band)", "") for m in said]
+
+
 def test_ball_load_sentence_holds_the_mount_against_iso_76():
     """The FE part states the most loaded wave-generator ball against ISO 76's 4200 MPa, and counts
     the designs above it; a study without the columns (an older run) says nothing."""
