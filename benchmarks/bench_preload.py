@@ -36,12 +36,12 @@ from _cli import add_shape_arguments, shape_of
 
 import numpy as np
 import pandas as pd
-from scipy.stats import spearmanr
 
 from hdwf.drive.geometry import drive_geometry
 from hdwf.drive.mesh import build_mesh
 from hdwf.fe import ISO76_BALL_PRESSURE_MPA, ModelChanges, solve_lost_motion
 from hdwf.fe.cycle import EXIT_ARC_DEG
+from hdwf.study.agreement import agreement as study_agreement
 
 ROOT = Path(__file__).resolve().parents[1]
 TABLES = {"hd42": "table4_hd42_fea.csv", "hd120": "table5_hd120_fea.csv"}
@@ -107,10 +107,10 @@ def _slope(table: pd.DataFrame, sets, phi: np.ndarray) -> float:
 def agreement(table: pd.DataFrame, ok: pd.DataFrame) -> dict[str, float]:
     """Ours against the paper over the solved designs ``ok`` (columns set, phi, phi_paper):
     median ratio, Spearman, R² (squared Pearson), dPhi/dr_FS ours and the paper's."""
-    many = len(ok) > 2
+    a = study_agreement(ok.phi_paper, ok.phi) if len(ok) > 2 else None
     return {"ratio": float(np.median(ok.phi / ok.phi_paper)),
-            "rho": spearmanr(ok.phi, ok.phi_paper)[0] if many else np.nan,
-            "r2": np.corrcoef(ok.phi, ok.phi_paper)[0, 1] ** 2 if many else np.nan,
+            "rho": a.spearman if a else np.nan,
+            "r2": a.r2 if a else np.nan,
             "slope": _slope(table, ok.set.to_numpy(), ok.phi.to_numpy()),
             "paper_slope": _slope(table, ok.set.to_numpy(), ok.phi_paper.to_numpy())}
 
