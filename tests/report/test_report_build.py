@@ -163,8 +163,8 @@ def test_agreement_section_labels_the_blind_drive_and_its_misses(named_inputs, t
 def test_agreement_section_gives_the_band_under_the_measured_mesh_scatter(named_inputs, tmp_path):
     """With a convergence table for the drive, a second table gives each figure's 5–95 % band when
     our Φ moves by the measured mesh changes: with ours = 1.2 × the paper's and changes far too small
-    to swap two of Table 4's designs (< 0.05 %), rank stays 1 and the ratio 1.2 ± 0.05 %; a missing
-    table leaves the band out."""
+    to swap two of Table 4's designs (< 0.05 %), rank stays 1, the ratio and the dΦ/dr_FS ratio
+    1.2 ± 0.05 %; a missing table leaves the band out."""
     import dataclasses
 
     import pandas as pd
@@ -184,8 +184,9 @@ def test_agreement_section_gives_the_band_under_the_measured_mesh_scatter(named_
     agreement_section(doc, ["hd42"], paper, ours, tmp_path, mesh_changes={"hd42": tmp_path / "conv.parquet"})
     tables = [b for b in doc.blocks if b["type"] == "table"]
     assert len(tables) == 2
-    name, changes, ratio, rho, r2 = tables[1]["rows"][0]
+    name, changes, ratio, rho, r2, slope = tables[1]["rows"][0]
     assert name == "HD 42" and changes == "2.0e-02 %, 5.0e-02 %" and rho == "1.000–1.000" and r2 == "1.000–1.000"
+    assert slope == "1.20× (1.20–1.20×)"   # the least-squares slope of 1.2 × Φ is 1.2 × the paper's
     lo, hi = (float(v) for v in ratio.split("–"))
     assert 1.2 * (1 - 5e-4) <= lo <= hi <= 1.2 * (1 + 5e-4)
     doc = Document("t", "s", PROVENANCE)

@@ -1,10 +1,12 @@
 """Agreement of ours with the paper's Φ, and its band under mesh scatter: against cases with known answers."""
 
 import numpy as np
+import pandas as pd
 import pytest
 from scipy import stats
 
 from hdwf.study.agreement import agreement, agreement_under_mesh_scatter
+from hdwf.study.knee import offset_slope_weights
 
 PAPER = np.array([0.34, 0.19, 0.33, 1.09, 0.25, 0.51, 0.71, 1.49, 0.22, 0.40, 0.95, 0.28])
 
@@ -72,3 +74,32 @@ def test_larger_scatter_widens_the_band_and_the_same_seed_repeats_it():
 def test_bad_input_is_refused_with_what_is_wrong(paper, ours, changes, match):
     with pytest.raises(ValueError, match=match):
         agreement_under_mesh_scatter(paper, ours, changes)
+
+
+def _designs(n: int = 27, seed: int = 5) -> pd.DataFrame:
+    rng = np.random.default_rng(seed)
+    return pd.DataFrame({"d_mm": 31 + 0.016 * rng.random(n), "D_mm": 41.984 + 0.016 * rng.random(n),
+                         "Gr_mm": 0.005 + 0.015 * rng.random(n), "rFS_mm": 0.02 * rng.random(n),
+                         "rCS_mm": 0.02 * rng.random(n)})
+
+
+def test_the_slope_band_is_the_least_squares_slope_ratio_and_scales_with_ours():
+    """Φ linear in the parameters: w · Φ is its r_FS coefficient exactly; with no mesh change the band
+    is that ratio, and ours × 3 triples it (the slope is linear in Φ)."""
+    designs = _designs()
+    w = offset_slope_weights(designs)["rFS_mm"]
+    paper = 0.2 + 28.0 * designs.rFS_mm + 29.0 * designs.rCS_mm + 5.0 * designs.Gr_mm   # 0.028 arcmin/µm
+    ours = 0.1 + 44.0 * designs.rFS_mm + 47.0 * designs.rCS_mm
+    assert w @ paper.to_numpy() == pytest.approx(0.028, rel=1e-9)
+    b = agreement_under_mesh_scatter(paper, ours, [0.0], slope_weights=w)
+    assert b.slope_ratio == pytest.approx((44 / 28, 44 / 28), rel=1e-9)
+    changes = [0.02, 0.05, 0.1]
+    b1 = agreement_under_mesh_scatter(paper, ours, changes, slope_weights=w)
+    b3 = agreement_under_mesh_scatter(paper, 3.0 * ours, changes, slope_weights=w)
+    assert b3.slope_ratio == pytest.approx(tuple(3.0 * v for v in b1.slope_ratio), rel=1e-9)
+    assert b1.slope_ratio[0] < 44 / 28 < b1.slope_ratio[1]
+
+
+def test_slope_weights_of_another_length_are_refused():
+    with pytest.raises(ValueError, match="one weight per design"):
+        agreement_under_mesh_scatter(PAPER, PAPER, [0.01], slope_weights=np.ones(3))

@@ -6,7 +6,8 @@ Pearson r squared) over the designs both have.
 ``agreement_under_mesh_scatter``: the same figures after each of our Φ is moved by a relative
 change drawn from the mesh changes measured on this drive (``convergence.parquet``'s
 ``rel_change_fine``: default mesh against a 1.25× finer one) with a random sign, many times
-(seeded). The band of the draws says how much of a gap to a target the mesh scatter alone could
+(seeded); with ``slope_weights`` also the ratio of a least-squares slope, ours over the paper's
+(dΦ/dr_FS, ``hdwf.study.knee.offset_slope_weights``). The band of the draws says how much of a gap to a target the mesh scatter alone could
 close or open. It is a sensitivity, not a confidence interval: the values already carry one
 draw of that scatter, and the changes of other designs of the same drive stand in for those of
 these designs.
@@ -43,6 +44,7 @@ class ScatterBand:
     median_ratio: tuple[float, float]
     spearman: tuple[float, float]
     r2: tuple[float, float]
+    slope_ratio: tuple[float, float] | None = None   # ours / the paper's least-squares slope, with slope_weights
 
 
 def _paired(paper: np.ndarray, ours: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -64,7 +66,7 @@ def agreement(paper, ours) -> Agreement:
 
 
 def agreement_under_mesh_scatter(paper, ours, rel_changes, draws: int = 2000, q: tuple[float, float] = (0.05, 0.95),
-                                 seed: int = SCATTER_SEED) -> ScatterBand:
+                                 seed: int = SCATTER_SEED, slope_weights=None) -> ScatterBand:
     """The band of ``agreement`` when each of ``ours`` is multiplied by 1 ± a change drawn from ``rel_changes``.
 
     Parameters
@@ -79,7 +81,14 @@ def agreement_under_mesh_scatter(paper, ours, rel_changes, draws: int = 2000, q:
         The quantiles reported.
     seed
         Seeds the draws.
+    slope_weights
+        Optional weights w (one per design, same order) with w · Φ a least-squares slope, e.g.
+        dΦ/dr_FS (``hdwf.study.knee.offset_slope_weights``): the band then has ``slope_ratio``,
+        our slope over the paper's. Needs every design to have both values.
     """
+    if slope_weights is not None and not (np.isfinite(np.asarray(paper, float)).all()
+                                          and np.isfinite(np.asarray(ours, float)).all()):
+        raise ValueError("slope_weights need both values on every design")
     paper, ours = _paired(paper, ours)
     changes = np.abs(np.asarray(rel_changes, float))
     changes = changes[np.isfinite(changes)]
@@ -98,4 +107,11 @@ def agreement_under_mesh_scatter(paper, ours, rel_changes, draws: int = 2000, q:
         lo, hi = np.quantile(values, q)
         return float(lo), float(hi)
 
-    return ScatterBand(q=tuple(q), draws=draws, median_ratio=band(ratio), spearman=band(rho), r2=band(r2))
+    slope_ratio = None
+    if slope_weights is not None:
+        w = np.asarray(slope_weights, float)
+        if w.shape != ours.shape:
+            raise ValueError(f"slope_weights must have one weight per design ({ours.size}), got shape {w.shape}")
+        slope_ratio = band(perturbed @ w / (w @ paper))
+    return ScatterBand(q=tuple(q), draws=draws, median_ratio=band(ratio), spearman=band(rho), r2=band(r2),
+                       slope_ratio=slope_ratio)

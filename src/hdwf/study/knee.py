@@ -143,9 +143,18 @@ def offset_slopes(designs: pd.DataFrame, column: str = "lost_motion_arcmin") -> 
         The coefficients of r_FS and r_CS per µm.
     """
     table = designs[np.isfinite(designs[column].to_numpy(float))]
-    A = np.column_stack([np.ones(len(table)), table[list(PARAMETER_COLUMNS)].to_numpy(float)])
-    coef = dict(zip(("intercept", *PARAMETER_COLUMNS), np.linalg.lstsq(A, table[column].to_numpy(float), rcond=None)[0]))
-    return float(coef["rFS_mm"]) * 1e-3, float(coef["rCS_mm"]) * 1e-3
+    phi = table[column].to_numpy(float)
+    weights = offset_slope_weights(table)
+    return float(weights["rFS_mm"] @ phi), float(weights["rCS_mm"] @ phi)
+
+
+def offset_slope_weights(designs: pd.DataFrame) -> dict[str, np.ndarray]:
+    """Per offset column, the weights w with w · Φ = its least-squares coefficient (arcmin/µm) over
+    ``designs``' rows (a linear fit in the five parameters): the slope of any Φ on these designs,
+    e.g. of many perturbed copies at once."""
+    A = np.column_stack([np.ones(len(designs)), designs[list(PARAMETER_COLUMNS)].to_numpy(float)])
+    rows = dict(zip(("intercept", *PARAMETER_COLUMNS), np.linalg.pinv(A)))
+    return {c: rows[c] * 1e-3 for c in ("rFS_mm", "rCS_mm")}
 
 
 @dataclass(frozen=True)
