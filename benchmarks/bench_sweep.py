@@ -10,15 +10,15 @@ axis: beyond about 45 deg a tip crossing in the exit zone). ``--out`` appends th
 (``DriveGeometry.deflection_coeff``), instead of or with the flank allowance; ``--offsets radial``
 reads r_FS, r_CS as rack shifts (``DriveGeometry.offset_direction``). ``--studies-model`` solves
 the model of the ``fe`` studies (``config.yaml``'s ``fe.effects``) instead of ``--preload``, and
-``--fit`` also prints the FS fit on the bearing's outer ring: the 1-degree bins closed (gap below
-0.05 um) after the mount and at +T, and the FS bore's largest inward and outward radial motion
+``--fit`` also prints the FS fit on the bearing's outer ring: the 1-degree bins closed (gap at the
+bin's centre below 0.05 um) after the mount and at +T, and the FS bore's largest inward and outward radial motion
 from the mount to +T, with their angles from the major axis (docs/fe-model.md, "HD 42's R²").
 
 Examples (docs/fe-alternatives.md, "Where the torque is carried"; docs/fe-model.md, "HD 42's R²"):
   OMP_NUM_THREADS=1 python benchmarks/bench_sweep.py --unit hd42 --base rFS_mm=0.016,rCS_mm=0.016 \\
       --vary d_mm=31.0,31.004,31.008,31.012,31.016 --preload 0.157
   OMP_NUM_THREADS=1 python benchmarks/bench_sweep.py --unit hd42 --base rFS_mm=0.014,rCS_mm=0.014 \\
-      --vary D_mm=42.0,41.996,41.992 --studies-model --fit
+      --vary D_mm=42.0,41.996,41.992 --studies-model --fit --steps-per-ramp 5
 """
 
 from __future__ import annotations
@@ -42,12 +42,13 @@ from hdwf.study.paper import load_bounds
 from hdwf.validation.effects import model_changes
 
 ROOT = Path(__file__).resolve().parents[1]
-FIT_BIN_DEG = np.arange(0.5, 180.0, 1.0)   # the half model's fit bins (contact_rows.fit_rows: 1-degree arcs)
+FIT_BIN_DEG = np.arange(0.0, 180.0, 1.0)   # the half model's fit bins' centres (contact_rows.fit_rows: 1-degree arcs)
 FIT_CLOSED_UM = 0.05
 
 
 def _radius_on_bins(mesh: DriveMesh, body: str, node_set: str, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Deformed radius and radial displacement (mm) of a circular boundary, at the fit bins' centres."""
+    """Deformed radius and radial displacement (mm) of a circular boundary at the fit bins' centres (point values,
+    not the bins' arc means)."""
     bm = mesh.bodies[body]
     ids = bm.node_sets[node_set]
     x, y = bm.mesh.p[:, ids]

@@ -103,3 +103,25 @@ def test_the_slope_band_is_the_least_squares_slope_ratio_and_scales_with_ours():
 def test_slope_weights_of_another_length_are_refused():
     with pytest.raises(ValueError, match="one weight per design"):
         agreement_under_mesh_scatter(PAPER, PAPER, [0.01], slope_weights=np.ones(3))
+
+
+def test_tied_values_rank_as_scipy_ranks_them():
+    """Spearman of every draw is Pearson of average ranks, scipy's definition with ties."""
+    ours = np.round(PAPER * np.linspace(0.7, 1.4, PAPER.size), 1)   # rounding makes ties
+    assert len(np.unique(ours)) < ours.size
+    b = agreement_under_mesh_scatter(PAPER, ours, [0.0])
+    assert b.spearman == pytest.approx((stats.spearmanr(PAPER, ours).statistic,) * 2, abs=1e-12)
+
+
+def test_the_share_of_draws_meeting_a_target_is_counted_from_the_draws():
+    ours = PAPER * np.linspace(0.7, 1.4, PAPER.size)
+    b = agreement_under_mesh_scatter(PAPER, ours, [0.05, 0.2], draws=500)
+    assert b.share("r2", b.r2[0], b.r2[1]) == pytest.approx(0.9, abs=0.005)   # between the 5 and 95 % quantiles
+    assert b.share("spearman", -1.0, 1.0) == 1.0 and b.share("median_ratio", 10.0) == 0.0
+    with pytest.raises(KeyError, match="slope_ratio"):
+        b.share("slope_ratio", 0.5, 2.0)   # no slope weights given
+
+
+def test_a_mesh_change_of_100_percent_or_more_is_refused():
+    with pytest.raises(ValueError, match="zero or negative"):
+        agreement_under_mesh_scatter(PAPER, PAPER, [0.02, 1.0])

@@ -7,15 +7,16 @@ Pearson r squared) over the designs both have.
 change drawn from the mesh changes measured on this drive (``convergence.parquet``'s
 ``rel_change_fine``: default mesh against a 1.25× finer one) with a random sign, many times
 (seeded); with ``slope_weights`` also the ratio of a least-squares slope, ours over the paper's
-(dΦ/dr_FS, ``hdwf.study.knee.offset_slope_weights``). The band of the draws says how much of a gap to a target the mesh scatter alone could
-close or open. It is a sensitivity, not a confidence interval: the values already carry one
+(dΦ/dr_FS, ``hdwf.study.knee.offset_slope_weights``). The band of the draws, and the share of
+draws that meet a target (``ScatterBand.share``), say how much of a gap to a target the mesh
+scatter alone could close or open. It is a sensitivity, not a confidence interval: the values already carry one
 draw of that scatter, and the changes of other designs of the same drive stand in for those of
 these designs.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import stats
@@ -37,7 +38,8 @@ class Agreement:
 
 @dataclass(frozen=True)
 class ScatterBand:
-    """Quantiles (``q``, e.g. 5 and 95 %) of the agreement figures over ``draws`` perturbed copies."""
+    """Quantiles (``q``, e.g. 5 and 95 %) of the agreement figures over ``draws`` perturbed copies,
+    and every draw's figures (``samples``, by figure name) for ``share``."""
 
     q: tuple[float, float]
     draws: int
@@ -45,6 +47,15 @@ class ScatterBand:
     spearman: tuple[float, float]
     r2: tuple[float, float]
     slope_ratio: tuple[float, float] | None = None   # ours / the paper's least-squares slope, with slope_weights
+    samples: dict[str, np.ndarray] = field(default_factory=dict, repr=False, compare=False)
+
+    def share(self, figure: str, low: float = -np.inf, high: float = np.inf) -> float:
+        """The fraction of the draws whose ``figure`` lies in [low, high], e.g. meets a target.
+        Exact, where the quantiles are rounded: a rank figure takes few values."""
+        if figure not in self.samples:
+            raise KeyError(f"no draws of {figure!r}; there are {sorted(self.samples)}")
+        values = self.samples[figure]
+        return float(np.mean((values >= low) & (values <= high)))
 
 
 def _paired(paper: np.ndarray, ours: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -94,6 +105,8 @@ def agreement_under_mesh_scatter(paper, ours, rel_changes, draws: int = 2000, q:
     changes = changes[np.isfinite(changes)]
     if changes.size == 0:
         raise ValueError("no measured mesh change to draw from")
+    if changes.max() >= 1.0:
+        raise ValueError(f"a relative mesh change of {changes.max():g} (>= 1) would make a lost motion zero or negative")
     rng = np.random.default_rng(seed)
     factor = 1.0 + rng.choice(changes, (draws, len(ours))) * rng.choice((-1.0, 1.0), (draws, len(ours)))
     perturbed = ours * factor
@@ -107,11 +120,12 @@ def agreement_under_mesh_scatter(paper, ours, rel_changes, draws: int = 2000, q:
         lo, hi = np.quantile(values, q)
         return float(lo), float(hi)
 
-    slope_ratio = None
+    samples = {"median_ratio": ratio, "spearman": rho, "r2": r2}
     if slope_weights is not None:
         w = np.asarray(slope_weights, float)
         if w.shape != ours.shape:
             raise ValueError(f"slope_weights must have one weight per design ({ours.size}), got shape {w.shape}")
-        slope_ratio = band(perturbed @ w / (w @ paper))
+        samples["slope_ratio"] = perturbed @ w / (w @ paper)
     return ScatterBand(q=tuple(q), draws=draws, median_ratio=band(ratio), spearman=band(rho), r2=band(r2),
-                       slope_ratio=slope_ratio)
+                       slope_ratio=band(samples["slope_ratio"]) if "slope_ratio" in samples else None,
+                       samples=samples)
