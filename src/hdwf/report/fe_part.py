@@ -283,6 +283,28 @@ def _target_checks(name: str, a: Agreement, slope_ratio: float, band: ScatterBan
     return missed, at_risk
 
 
+def _scatter_table(doc: Document, rows: list[list[str]]) -> None:
+    doc.text("How far the mesh alone moves these figures: each of our $Phi$ is moved by a relative change drawn "
+             "from the mesh changes measured on the same drive (the designs of the mesh-convergence study, default mesh against "
+             "1.25× finer; Mesh convergence above) with a random sign, 2000 times (seeded). A target met in "
+             "some draws and missed in others could be met or missed by mesh scatter of that size alone; the "
+             "verdict below gives the share of draws that meet each target missed, or met in fewer than 95 %.")
+    doc.table(["drive", "mesh change", "median ratio", "Spearman $rho$", "$R^2$",
+               "$d Phi slash d r_\"FS\"$ ours/paper"], rows,
+              "The agreement figures under the measured mesh scatter, 5–95 % of the draws (mesh change: median "
+              "and largest measured; `hdwf.study.agreement`).")
+
+
+def _verdict_text(misses: list[str], at_risk: list[str]) -> str:
+    lo, hi = AGREEMENT_TARGETS["median_ratio"]
+    s_lo, s_hi = AGREEMENT_TARGETS["slope_ratio"]
+    return (f"Targets (level, rank, shape, offset slope): median ratio within [{lo}, {hi}], Spearman $rho >= "
+            f"{AGREEMENT_TARGETS['spearman']}$, $R^2 >= {AGREEMENT_TARGETS['r2']}$, least-squares "
+            f"$d Phi slash d r_\"FS\"$ within [{s_lo}, {s_hi:g}]× the paper's. "
+            + ("Missed: " + "; ".join(misses) + "." if misses else "All met.")
+            + (" Met, but not in 95 % of the mesh-scatter draws: " + "; ".join(at_risk) + "." if at_risk else ""))
+
+
 def agreement_section(doc: Document, units: list[str], paper: StudyArtefacts, ours: StudyArtefacts, tmp: Path,
                       settings: FeSettings | None = None, level: int = 1,
                       mesh_changes: dict[str, Path] | None = None) -> None:
@@ -341,26 +363,12 @@ def agreement_section(doc: Document, units: list[str], paper: StudyArtefacts, ou
                "median ratio ours/paper", "ratio range"], rows,
               "Agreement of our $Phi$ with the paper's at the 27 design points of Tables 4/5 ($R^2$ of a linear fit).")
     if scatter_rows:
-        doc.text("How far the mesh alone moves these figures: each of our $Phi$ is moved by a relative change drawn "
-                 "from the mesh changes measured on the same drive (the designs of the mesh-convergence study, default mesh against "
-                 "1.25× finer; Mesh convergence above) with a random sign, 2000 times (seeded). A target met in "
-                 "some draws and missed in others could be met or missed by mesh scatter of that size alone; the "
-                 "verdict below gives the share of draws that meet each target missed, or met in fewer than 95 %.")
-        doc.table(["drive", "mesh change", "median ratio", "Spearman $rho$", "$R^2$",
-                   "$d Phi slash d r_\"FS\"$ ours/paper"], scatter_rows,
-                  "The agreement figures under the measured mesh scatter, 5–95 % of the draws (mesh change: median "
-                  "and largest measured; `hdwf.study.agreement`).")
+        _scatter_table(doc, scatter_rows)
     path = tmp / "agreement.png"
     agreement_figure(pairs, "hdwf FE vs the paper's Ansys FEA, same 27 designs", path)
     doc.figure(path, "Our lost motion against the paper's at the same design points.",
                width="100%" if len(pairs) > 1 else "55%")
-    lo, hi = AGREEMENT_TARGETS["median_ratio"]
-    s_lo, s_hi = AGREEMENT_TARGETS["slope_ratio"]
-    verdict = (f"Targets (level, rank, shape, offset slope): median ratio within [{lo}, {hi}], Spearman $rho >= "
-               f"{AGREEMENT_TARGETS['spearman']}$, $R^2 >= {AGREEMENT_TARGETS['r2']}$, least-squares "
-               f"$d Phi slash d r_\"FS\"$ within [{s_lo}, {s_hi:g}]× the paper's. "
-               + ("Missed: " + "; ".join(misses) + "." if misses else "All met.")
-               + (" Met, but not in 95 % of the mesh-scatter draws: " + "; ".join(at_risk) + "." if at_risk else ""))
+    verdict = _verdict_text(misses, at_risk)
     if effects:
         doc.text(f"Our model here: the section with {effects_text(effects)}. " + verdict + " The knee below "
                  "shows where the shape parts: the uniform 2D section either holds the teeth preloaded or has "

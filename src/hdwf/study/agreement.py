@@ -3,15 +3,14 @@
 ``agreement``: level (median ratio ours / paper), rank (Spearman ρ) and shape (R² of a linear fit,
 Pearson r squared) over the designs both have.
 
-``agreement_under_mesh_scatter``: the same figures after each of our Φ is moved by a relative
-change drawn from the mesh changes measured on this drive (``convergence.parquet``'s
-``rel_change_fine``: default mesh against a 1.25× finer one) with a random sign, many times
-(seeded); with ``slope_weights`` also the ratio of a least-squares slope, ours over the paper's
-(dΦ/dr_FS, ``hdwf.study.knee.offset_slope_weights``). The band of the draws, and the share of
-draws that meet a target (``ScatterBand.share``), say how much of a gap to a target the mesh
-scatter alone could close or open. It is a sensitivity, not a confidence interval: the values already carry one
-draw of that scatter, and the changes of other designs of the same drive stand in for those of
-these designs.
+``agreement_under_mesh_scatter``: the same figures after each of our Φ is moved by a relative change
+drawn from the mesh changes measured on this drive (``convergence.parquet``'s ``rel_change_fine``:
+default mesh against a 1.25× finer one) with a random sign, many times (seeded); with
+``slope_weights`` also the ratio of a least-squares slope, ours over the paper's (dΦ/dr_FS,
+``hdwf.study.knee.offset_slope_weights``). The band of the draws, and the share of draws that meet a
+target (``ScatterBand.share``), say how much of a gap to a target the mesh scatter alone could close
+or open. It is a sensitivity, not a confidence interval: the values already carry one draw of that
+scatter, and the changes of other designs of the same drive stand in for those of these designs.
 """
 
 from __future__ import annotations
