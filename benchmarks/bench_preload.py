@@ -42,6 +42,7 @@ from hdwf.drive.mesh import build_mesh
 from hdwf.fe import ISO76_BALL_PRESSURE_MPA, ModelChanges, solve_lost_motion
 from hdwf.fe.cycle import EXIT_ARC_DEG
 from hdwf.study.agreement import agreement as study_agreement
+from hdwf.study.knee import offset_slope_weights
 
 ROOT = Path(__file__).resolve().parents[1]
 TABLES = {"hd42": "table4_hd42_fea.csv", "hd120": "table5_hd120_fea.csv"}
@@ -99,9 +100,7 @@ def _slope(table: pd.DataFrame, sets, phi: np.ndarray) -> float:
     """dPhi/dr_FS (arcmin/um) by least squares over the five inputs (7+ designs)."""
     if len(sets) < 7:
         return np.nan
-    X = np.column_stack([np.ones(len(sets))] + [table.loc[sets, c].to_numpy() * 1e3
-                                                 for c in COLUMNS])
-    return float(np.linalg.lstsq(X, phi, rcond=None)[0][4])
+    return float(offset_slope_weights(table.loc[sets])["rFS_mm"] @ phi)
 
 
 def agreement(table: pd.DataFrame, ok: pd.DataFrame) -> dict[str, float]:

@@ -54,10 +54,9 @@ def _radius_on_bins(mesh: DriveMesh, body: str, node_set: str, u: np.ndarray) ->
     x, y = bm.mesh.p[:, ids]
     r = np.hypot(x, y)
     ur = (u[body][0, ids] * x + u[body][1, ids] * y) / r
-    order = np.argsort(np.degrees(np.arctan2(y, x)) % 180.0)
-    angle = (np.degrees(np.arctan2(y, x)) % 180.0)[order]
-    return (np.interp(FIT_BIN_DEG, angle, (r + ur)[order], period=180.0),
-            np.interp(FIT_BIN_DEG, angle, ur[order], period=180.0))
+    angle = np.degrees(np.arctan2(y, x)) % 180.0
+    return (np.interp(FIT_BIN_DEG, angle, r + ur, period=180.0),
+            np.interp(FIT_BIN_DEG, angle, ur, period=180.0))
 
 
 def fit_state(mesh: DriveMesh, fields: dict) -> dict:

@@ -337,14 +337,14 @@ def agreement_section(doc: Document, units: list[str], paper: StudyArtefacts, ou
     rows, pairs, misses, at_risk, scatter_rows = [], {}, [], [], []
     for u in units:
         theirs = pd.read_parquet(paper.drive(u).lost_motion).set_index("design_id")["lost_motion_arcmin"]
-        mine = pd.read_parquet(ours.drive(u).lost_motion).set_index("design_id")["lost_motion_arcmin"]
+        our_table = pd.read_parquet(ours.drive(u).lost_motion).set_index("design_id")
+        mine = our_table["lost_motion_arcmin"]
         both = pd.concat({"paper": theirs, "ours": mine}, axis=1).dropna()
         a = agreement(both["paper"], both["ours"])
         ratio = both["ours"] / both["paper"]
         pairs[UNIT_NAMES[u]] = (theirs.reindex(mine.index).to_numpy(float), mine.to_numpy(float))
         role = "" if not (effects and calibrated_on) else (" (calibrated)" if u == calibrated_on else " (blind)")
-        designs = pd.read_parquet(ours.drive(u).lost_motion).set_index("design_id").loc[both.index]
-        weights = offset_slope_weights(designs)["rFS_mm"]
+        weights = offset_slope_weights(our_table.loc[both.index])["rFS_mm"]
         slope_ratio = (weights @ both["ours"].to_numpy()) / (weights @ both["paper"].to_numpy())
         band = None
         if mesh_changes and mesh_changes.get(u):
