@@ -6,7 +6,7 @@ import pytest
 import scipy.sparse as sp
 
 from hdwf.fe.bodies import factorize_spd, plane_stress_lame
-from hdwf.fe.column_store import ColumnStore
+from hdwf.fe.column_store import CHUNK_ROWS, ColumnStore
 from hdwf.fe.solver import _solve_kkt
 
 
@@ -83,3 +83,42 @@ def test_column_store_combination_is_the_weighted_sum_of_its_columns(active):
     positions = np.sort(rng.choice(60, size=active, replace=False))
     weights = rng.standard_normal(active)
     assert np.allclose(store.combine(positions, weights), X[:, positions] @ weights, rtol=0, atol=1e-12)
+
+
+def test_column_store_copies_are_independent_across_chunks():
+    """A copy shares its original's chunks until one side writes: renewing or adding columns on
+    either side never shows on the other (stores of more than one chunk, appends that straddle
+    a chunk boundary)."""
+    rng = np.random.default_rng(7)
+    n = CHUNK_ROWS + 40
+    X = rng.standard_normal((12, n))
+    store = ColumnStore(12)
+    store.append(X[:, :CHUNK_ROWS - 5])
+    store.append(X[:, CHUNK_ROWS - 5:])            # straddles the first chunk's end
+    twin = store.copy()
+    renewed = rng.standard_normal((12, 2))
+    twin.replace(np.array([3, CHUNK_ROWS + 1]), renewed)
+    extra = rng.standard_normal((12, 3))
+    store.append(extra)
+    assert np.array_equal(store.columns, np.hstack([X, extra]))
+    expected = X.copy()
+    expected[:, [3, CHUNK_ROWS + 1]] = renewed
+    assert np.array_equal(twin.columns, expected)
+    assert twin.size == n and store.size == n + 3
+
+
+def test_column_store_projection_and_products_match_dense_algebra():
+    """``project`` from a start inside a chunk, ``right_multiply`` and the one-pass ``combine``
+    equal the dense products of the stacked columns."""
+    rng = np.random.default_rng(11)
+    n = 2 * CHUNK_ROWS + 17
+    X = rng.standard_normal((20, n))
+    store = ColumnStore(20)
+    store.append(X)
+    G = sp.random(6, 20, density=0.3, random_state=3, format="csr")
+    start, stop = CHUNK_ROWS - 9, 2 * CHUNK_ROWS + 4
+    assert np.allclose(store.project(G, stop, start), G @ X[:, start:stop], rtol=0, atol=1e-12)
+    C = sp.random(n, 4, density=0.05, random_state=5, format="csc")
+    assert np.allclose(store.right_multiply(C), X @ C.toarray(), rtol=0, atol=1e-12)
+    w = rng.standard_normal(n)
+    assert np.allclose(store.combine(np.arange(n), w), X @ w, rtol=0, atol=1e-11)

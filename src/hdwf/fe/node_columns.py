@@ -133,5 +133,5 @@ class NodeColumns:
     def combine(self, C: sp.csc_matrix) -> tuple[np.ndarray, np.ndarray]:
         """Responses (n_watch_dofs x k) and twists (k) of the loads C (size x k) in the stored
         basis."""
-        both = np.asarray(C.T @ self._store.columns.T).T
+        both = self._store.right_multiply(C)
         return both[:-1], both[-1]
