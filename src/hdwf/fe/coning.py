@@ -50,6 +50,7 @@ import numpy as np
 from hdwf.drive.cam import cam_for_push
 from hdwf.drive.geometry import ARCMIN, DriveGeometry
 from hdwf.drive.mesh import DriveMesh
+from hdwf.fe.changes import ModelChanges
 from hdwf.fe.cycle import ZERO_TORQUE_BIAS, mount_wave_generator
 from hdwf.fe.model import LostMotionModel
 from hdwf.fe.preload import PRELOAD_ZONE_DEG
@@ -122,7 +123,7 @@ def build_slice(base: LostMotionModel, geom: DriveGeometry, push: float) -> Slic
     """Mount the wave generator of push ``push`` on a fork of ``base`` (shared factorisation)
     with the teeth ramped in, free the FS rotation and sample the curve on both sides."""
     model = base.fork()
-    model.geometry = coned_geometry(geom, push)
+    model.geometry = coned_geometry(base.geometry, push)    # (with the base's flank layer)
     mounted = mount_wave_generator(model, True)
     model.mode_list = model.mode_list + [("fs", "rot")]
     curve = SliceCurve(push)
@@ -216,7 +217,8 @@ def combine(curves: dict, coning: float, n_slices: int, test_torque: float) -> C
 
 
 def solve_coned(geom: DriveGeometry, mesh: DriveMesh, cases: list[tuple[float, int]],
-                zone_deg: float = PRELOAD_ZONE_DEG) -> list[ConedResult]:
+                zone_deg: float = PRELOAD_ZONE_DEG,
+                changes: ModelChanges | None = None) -> list[ConedResult]:
     """Phi of one design for several (coning slope c, slice count N), sharing the mesh, the
     factorisation and every slice whose push two cases have in common.
 
@@ -230,6 +232,9 @@ def solve_coned(geom: DriveGeometry, mesh: DriveMesh, cases: list[tuple[float, i
         (c, N) pairs.
     zone_deg : float
         Half width of the watched tooth zones (every tooth by default).
+    changes : ModelChanges, optional
+        Effects of the model (e.g. the flank layer), as for ``solve_lost_motion``; the geometry
+        carries their part already (``ModelChanges.geometry_part``).
 
     Returns
     -------
@@ -237,7 +242,7 @@ def solve_coned(geom: DriveGeometry, mesh: DriveMesh, cases: list[tuple[float, i
         One per case; a failed slice fails every case that uses it (status "failed", no number).
     """
     try:
-        base = LostMotionModel(geom, mesh, zone_deg=zone_deg)
+        base = LostMotionModel(geom, mesh, zone_deg=zone_deg, changes=changes)
     except Exception as exc:   # any failure is reported, never a silent number
         return [ConedResult(math.nan, math.nan, math.nan, "failed", f"{type(exc).__name__}: {exc}",
                             (), 0, 0) for _ in cases]
