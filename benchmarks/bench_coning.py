@@ -1,8 +1,8 @@
 """Coning (quasi-3D slices, ``hdwf.fe.coning``) against the paper's Tables 4/5.
 
-Every design of the table (coarse half mesh 5 x 3, as ``bench_preload``; relieved tips
-``--tip-relief``, every tooth watched) is solved at each ``--interference`` (units of m; a
-new FS outline, a new mesh) for every coning slope ``--coning`` c and slice count
+Every design of the table (half mesh ``--mesh``, coarse 5 x 3 by default, as ``bench_preload``;
+relieved tips ``--tip-relief``, a flank layer ``--flank-layer``, every tooth watched) is solved
+at each ``--interference`` (units of m; a new FS outline, a new mesh) for every coning slope ``--coning`` c and slice count
 ``--slices`` N; the slices of one design and interference share the mesh, the factorisation
 and every slice push two cases have in common.  One row per (design, interference, c, N) is
 appended to ``--out``: status (a failed slice fails the case: no number), Phi, the paper's
@@ -34,12 +34,13 @@ from scipy.stats import spearmanr
 from bench_preload import COLUMNS, ROOT, TABLES, _sets, agreement
 from hdwf.drive.geometry import ARCMIN, drive_geometry
 from hdwf.drive.mesh import build_mesh
+from hdwf.fe.changes import ModelChanges
 from hdwf.fe.coning import solve_coned
 from hdwf.study.paper import load_bounds
 
 
 def solve_all(unit: str, sets: list[int], interferences: list[float], cases: list[tuple[float, int]],
-              out: Path, tip_relief: float):
+              out: Path, tip_relief: float, flank_layer: float = 0.0, mesh_size: tuple[int, int] = (5, 3)):
     table = pd.read_csv(ROOT / "data" / "paper" / TABLES[unit]).set_index("set")
     for s in sets:
         row = table.loc[s]
@@ -47,23 +48,25 @@ def solve_all(unit: str, sets: list[int], interferences: list[float], cases: lis
             g = drive_geometry(unit, *(row[c] for c in COLUMNS), interference_m=im,
                                tip_relief=tip_relief)
             t0 = time.perf_counter()
-            mesh = build_mesh(g, elements_over_height=5, elements_over_thickness=3, symmetry="half")
+            mesh = build_mesh(g, elements_over_height=mesh_size[0], elements_over_thickness=mesh_size[1],
+                              symmetry="half")
             mesh_s = time.perf_counter() - t0
             t1 = time.perf_counter()
-            results = solve_coned(g, mesh, cases)
+            results = solve_coned(g, mesh, cases, changes=ModelChanges(flank_layer_m=flank_layer))
             solve_s = time.perf_counter() - t1
             recs = []
             for (c, n), r in zip(cases, results):
                 recs.append({"unit": unit, "set": s, "interference_m": im, "tip_relief": tip_relief,
+                             "flank_layer_m": flank_layer, "mesh": f"{mesh_size[0]}x{mesh_size[1]}",
                              "coning": c, "slices": n, "status": r.status, "reason": r.reason[:200],
                              "phi": r.lost_motion_arcmin, "phi_plus": r.phi_plus_arcmin,
                              "phi_minus": r.phi_minus_arcmin, "phi_paper": row["lost_motion_arcmin"],
-                             "levels": r.levels, "rounds": r.rounds, "design_solve_s": solve_s,
+                             "levels": r.levels, "evaluations": r.evaluations, "design_solve_s": solve_s,
                              "mesh_s": mesh_s,
                              "pushes": " ".join(f"{k:.4f}" for k in r.pushes)})
                 print(f"{unit} set {s:2d} δ={im:.3f} m c={c:g} N={n}: {r.status} "
                       f"Φ {r.lost_motion_arcmin:.4f} (paper {row['lost_motion_arcmin']:.4f}) "
-                      f"levels {r.levels} rounds {r.rounds} {r.reason[:100]}", flush=True)
+                      f"levels {r.levels} evaluations {r.evaluations} {r.reason[:100]}", flush=True)
             print(f"   design solve {solve_s:.1f} s, mesh {mesh_s:.1f} s", flush=True)
             pd.DataFrame(recs).to_csv(out, mode="a", header=not out.exists(), index=False)
 
@@ -117,6 +120,9 @@ if __name__ == "__main__":
     ap.add_argument("--cases", default="",
                     help="explicit c:N pairs, e.g. 0:1,0.4:4 (instead of --coning x --slices)")
     ap.add_argument("--tip-relief", type=float, default=1.1)
+    ap.add_argument("--flank-layer", type=float, default=0.0,
+                    help="flank layer thickness in units of m (the studies' model: 4200)")
+    ap.add_argument("--mesh", default="5x3", help="elements over tooth height x thickness")
     ap.add_argument("--out", type=Path, default=Path("coning.csv"))
     ap.add_argument("--summary-only", action="store_true")
     ap.add_argument("--cup-K", type=float, default=None,
@@ -128,5 +134,5 @@ if __name__ == "__main__":
         cases = [(float(c), int(n)) for c in a.coning.split(",") for n in a.slices.split(",")]
     if not a.summary_only:
         solve_all(a.unit, _sets(a.sets), [float(x) for x in a.interference.split(",")], cases,
-                  a.out, a.tip_relief)
+                  a.out, a.tip_relief, a.flank_layer, tuple(int(x) for x in a.mesh.split("x")))
     summary(a.out, a.cup_K)

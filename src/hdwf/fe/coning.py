@@ -20,29 +20,30 @@ Slices in parallel.  Every slice carries b/N of the face width; in plane stress 
 stiffness of the section scales with its thickness, so a slice at torque T_j behaves as the
 full section at N T_j (the ball springs are scaled with it: the bearing is smeared over the
 face width).  All slices share the FS output rotation theta and the torques add:
-T = (1/N) sum_j T'_j(theta), T'_j the full section's torque-twist relation at push k_j.
+T(theta) = (1/N) sum_j T'_j(theta), T'_j the full section's torque at twist theta and push k_j.
 
-Why combining curves is exact for our Phi.  ``cycle`` defines Phi = theta(+T) - theta(-T)
-(the twists at +-T minus the first state's, which cancels).  Frictionless contact is
-elastic and path independent: the state at a torque does not depend on the levels before
-it (up to the re-linearisation of the tooth rows at a state, ``relinearise.redetect_teeth``).
-So theta(+-T) of the slices in parallel is found from each slice's twist-torque relation
-alone: sample it, invert the summed monotone relation mean_j T'_j(theta) = +-T, then solve
-every slice at its share T'_j* and insert that point (``refine``) until every slice's
-twist equals the common theta to ``THETA_TOL``; at that point the combination is the
-coupled solution of N sections sharing one rotation, not an interpolation.
+Displacement control.  Each slice is solved at a prescribed rim twist (``solver.Twist``: the
+torque is the unknown), so at a given theta the slices are independent, and a preloaded slice
+that would snap between two equilibria under a torque has one state at a twist.  Every state
+is solved on a fork of the slice's mount (the same starting rows) and its tooth and cam rows
+settled to the true gap at that state (``relinearise.settle``), as the main test settles its
+states at +-T: the torque at a twist does not depend on the twists solved before it.  The
+twist at +-T is found on the path from the mount, theta growing in the torque's direction:
+steps until T(theta) passes the torque, then regula falsi (Illinois) to ``THETA_TOL``;
+Phi = theta(+T) - theta(-T).
 
 What it neglects.  The slices exchange no shear (a continuous cup couples neighbouring
 sections; a plane-stress section at each z is the classic multi-section / "quasi-3D"
 approximation), the cup's torsion between the slices and the output (every slice's rim is
 tied to the same rotation), the bearing's own tilt and edge loading, and friction (with
-friction Phi is path dependent and the combination would not hold).  The tooth profile and
+friction a state depends on its path; a prescribed twist is solved frictionless only).  The tooth profile and
 relief are the same in every slice (no profile modification along the face).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -51,18 +52,16 @@ from hdwf.drive.cam import cam_for_push
 from hdwf.drive.geometry import ARCMIN, DriveGeometry
 from hdwf.drive.mesh import DriveMesh
 from hdwf.fe.changes import ModelChanges
-from hdwf.fe.cycle import ZERO_TORQUE_BIAS, mount_wave_generator
+from hdwf.fe.cycle import mount_wave_generator
 from hdwf.fe.model import LostMotionModel
 from hdwf.fe.preload import PRELOAD_ZONE_DEG
-from hdwf.fe.relinearise import redetect_teeth
-from hdwf.fe.solver import ContactFailure
+from hdwf.fe.relinearise import GEO_MAX_IT, GEO_TOL, settle
+from hdwf.fe.solver import ContactFailure, Twist
 
-# torques first sampled on each slice's curve, as multiples of the test torque (each side);
-# a slice that has to carry more is sampled further out (twice its largest) when needed
-SAMPLE_FRACTIONS = (ZERO_TORQUE_BIAS, 0.25, 0.5, 1.0, 2.0)
-THETA_TOL = 5e-3 * ARCMIN   # rad: slice twists at the combined solution agree to this (about 3x
-                            # the contact tolerance: 0.01 um over r_b ~ 20 mm is 1.7e-3 arcmin)
-MAX_REFINE = 12             # refinement rounds per torque
+THETA_TOL = 1e-3 * ARCMIN   # rad: the twist at +-T to this (0.3 % of a 0.3 arcmin Phi)
+MAX_EVALUATIONS = 40        # twists tried per torque
+FIRST_STEP = 0.02 * ARCMIN  # rad: the first twist tried (a tenth of a preloaded HD 42's Phi/2;
+                            # the secant steps grow it at most 4 times a step)
 
 
 def slice_pushes(coning: float, n_slices: int) -> np.ndarray:
@@ -78,113 +77,87 @@ def coned_geometry(geom: DriveGeometry, push: float) -> DriveGeometry:
     return replace(geom, cam_A=A, cam_B=B)
 
 
+def twist_at_torque(torque_at: Callable[[float], float], target: float, first_step: float,
+                    tol: float = THETA_TOL, max_evaluations: int = MAX_EVALUATIONS) -> tuple[float, int]:
+    """The first twist on the path from 0 (growing in the sign of ``target``) where the
+    torque-twist relation ``torque_at`` reaches ``target``; returns (theta, evaluations).
+
+    Steps out from 0 (the first ``first_step``, then the secant's extrapolation, at least 1.5
+    and at most 4 times the last twist) until the torque passes the target, then regula
+    falsi with the Illinois rule until the bracket is narrower than ``tol``.  Raises
+    ``ContactFailure`` if ``max_evaluations`` do not reach that."""
+    sign = math.copysign(1.0, target)
+    lo, t_lo = 0.0, torque_at(0.0)
+    hi, count = sign * abs(first_step), 1
+    while True:
+        t_hi = torque_at(hi)
+        count += 1
+        if sign * (t_hi - target) >= 0:
+            break
+        if count >= max_evaluations:
+            raise ContactFailure(f"coning: torque {target:.4g} N mm not reached by twist "
+                                 f"{hi / ARCMIN:.4g} arcmin")
+        slope = (t_hi - t_lo) / (hi - lo)
+        guess = hi + (target - t_hi) / slope if sign * slope > 0 else 4 * hi
+        lo, t_lo, hi = hi, t_hi, sign * min(max(sign * guess, 1.5 * abs(hi)), 4 * abs(hi))
+    side = 0      # Illinois: halve the weight of an end kept twice
+    while abs(hi - lo) > tol:
+        if count >= max_evaluations:
+            raise ContactFailure(f"coning: twist at torque {target:.4g} N mm not within "
+                                 f"{tol / ARCMIN:.1e} arcmin after {count} evaluations")
+        theta = lo + (target - t_lo) * (hi - lo) / (t_hi - t_lo)
+        theta = min(max(theta, min(lo, hi) + 0.1 * tol), max(lo, hi) - 0.1 * tol)
+        t = torque_at(theta)
+        count += 1
+        if sign * (t - target) >= 0:
+            hi, t_hi = theta, t
+            if side == -1:
+                t_lo = target + 0.5 * (t_lo - target)
+            side = -1
+        else:
+            lo, t_lo = theta, t
+            if side == 1:
+                t_hi = target + 0.5 * (t_hi - target)
+            side = 1
+    return lo + (target - t_lo) * (hi - lo) / (t_hi - t_lo), count
+
+
 @dataclass
-class SliceCurve:
-    """One slice (push k): its mounted model on each side and the sampled (T', theta) points."""
+class Slice:
+    """One slice (push k): its mounted model, FS rotation free, and the torques it has needed
+    at the twists asked (full-section torque T', N mm)."""
     push: float
-    models: dict = field(default_factory=dict)     # side (+1/-1) -> [model, active]
-    torque: list = field(default_factory=list)     # T' (N mm), full-section torque
-    twist: list = field(default_factory=list)      # theta (rad), absolute rim twist
+    model: LostMotionModel
+    active: dict = field(default_factory=dict)       # side (+1/-1) -> warm-start active set
+    torques: dict = field(default_factory=dict)      # twist (rad) -> T'
     levels: int = 0
 
-    def solve(self, torque: float) -> float:
-        """Solve the slice at full-section torque ``torque`` (N mm), record and return theta."""
-        side = 1 if torque > 0 else -1
-        model, active = self.models[side]
-        level = model.solve_level(torque, active)
-        level, _ = redetect_teeth(model, torque, level)
-        self.models[side][1] = level.active
-        self.torque.append(float(torque))
-        self.twist.append(float(level.twist))
+    def torque_at(self, theta: float) -> float:
+        """T' at rim twist ``theta`` (rad): solved on a fork of the mount and settled."""
+        if theta in self.torques:
+            return self.torques[theta]
+        side = 1 if theta >= 0 else -1
+        at = self.model.fork()
+        level = at.solve_level(Twist(theta), self.active[side])
+        level, err, ok = settle(at, level, Twist(theta), GEO_TOL)
+        if not ok:
+            raise ContactFailure(f"coning: slice k={self.push:.4f} at {theta / ARCMIN:.4g} arcmin: "
+                                 f"tooth gaps {err * 1000:.3f} um off their linearisation after "
+                                 f"{GEO_MAX_IT} re-linearisations")
+        self.active[side] = level.active
         self.levels += 1
-        return float(level.twist)
-
-    def relation(self, side: int) -> tuple[np.ndarray, np.ndarray]:
-        """The relation sampled on ``side`` (+1: T' > 0, -1: T' < 0) sorted by torque:
-        (theta, T'); raises if not monotone.
-
-        One side only: the two sides are reached on separate paths from the mount, and a
-        locked slice's states at +bias and -bias can cross by a few contact tolerances
-        (twist(-bias) > twist(+bias)), which is not a property of either side's relation.
-        Between the sides the slice sits in its backlash and carries (about) the bias."""
-        T, th = np.array(self.torque), np.array(self.twist)
-        keep = np.sign(T) == side
-        order = np.argsort(T[keep])
-        T, th = T[keep][order], th[keep][order]
-        drop = -np.diff(th).min(initial=0.0)
-        if drop > THETA_TOL:
-            raise ContactFailure(f"coning: slice k={self.push:.4f} twist not monotone in torque "
-                                 f"on the {'+' if side > 0 else '-'} side (falls by "
-                                 f"{drop / ARCMIN:.2e} arcmin)")
-        return np.maximum.accumulate(th), T
+        self.torques[theta] = level.torque
+        return level.torque
 
 
-def build_slice(base: LostMotionModel, geom: DriveGeometry, push: float) -> SliceCurve:
+def build_slice(base: LostMotionModel, push: float) -> Slice:
     """Mount the wave generator of push ``push`` on a fork of ``base`` (shared factorisation)
-    with the teeth ramped in, free the FS rotation and sample the curve on both sides."""
+    with the teeth ramped in, and free the FS rotation."""
     model = base.fork()
     model.geometry = coned_geometry(base.geometry, push)    # (with the base's flank layer)
     mounted = mount_wave_generator(model, True)
     model.mode_list = model.mode_list + [("fs", "rot")]
-    curve = SliceCurve(push)
-    for side in (1, -1):
-        m = model.fork()
-        curve.models[side] = [m, mounted.solution.active]
-        # as in ``cycle``: the bias first (not kept: a lightly preloaded FS can sit at the
-        # mount in a detent of two near-radial tip contacts that a small torque does not
-        # leave, a state the loaded branch never returns to), then up the loaded branch and
-        # back to the bias, the edge of the backlash on that side
-        level = m.solve_level(side * ZERO_TORQUE_BIAS * geom.torque, mounted.solution.active)
-        curve.models[side][1] = level.active
-        for f in SAMPLE_FRACTIONS[1:] + SAMPLE_FRACTIONS[:1]:
-            curve.solve(side * f * geom.torque)
-    return curve
-
-
-def _combined_theta(curves: list[SliceCurve], torque: float) -> tuple[float, np.ndarray]:
-    """theta with mean_j T'_j(theta) = torque on the piecewise-linear sampled relations, and
-    each slice's share T'_j there."""
-    rel = [c.relation(1 if torque > 0 else -1) for c in curves]
-    grid = np.unique(np.concatenate([th for th, _ in rel]))
-    total = np.mean([np.interp(grid, th, T) for th, T in rel], axis=0)
-    if not (total[0] <= torque <= total[-1]):
-        raise ContactFailure(f"coning: torque {torque:.4g} N mm outside the sampled range")
-    total = np.maximum.accumulate(total)
-    # the first grid point where the summed relation reaches the torque (flat parts: any)
-    k = int(np.searchsorted(total, torque))
-    if k == 0:
-        theta = grid[0]
-    else:
-        a, b = total[k - 1], total[k]
-        theta = grid[k] if b == a else grid[k - 1] + (torque - a) / (b - a) * (grid[k] - grid[k - 1])
-    shares = np.array([np.interp(theta, th, T) for th, T in rel])
-    return float(theta), shares
-
-
-def coupled_twist(curves: list[SliceCurve], torque: float) -> tuple[float, int]:
-    """The common twist of the slices in parallel at ``torque`` (N mm), refined until each
-    slice solved at its share has that twist to ``THETA_TOL``; returns (theta, rounds).
-
-    A slice whose sampled relation ends before the combined twist is first sampled further
-    out (twice its largest torque on that side); a slice whose share lies within its
-    zero-torque band (|T'_j| <= the bias) sits in its backlash and is not solved."""
-    sign, worst = (1.0 if torque > 0 else -1.0), math.inf
-    for rounds in range(MAX_REFINE):
-        theta, shares = _combined_theta(curves, torque)
-        short = [c for c in curves if sign * (theta - c.relation(int(sign))[0][-1 if sign > 0 else 0]) > 0]
-        for c in short:
-            c.solve(2.0 * (max(c.torque) if sign > 0 else min(c.torque)))
-        if short:
-            continue
-        worst = 0.0
-        for c, Tj in zip(curves, shares):
-            if abs(Tj) <= ZERO_TORQUE_BIAS * abs(torque) * (1 + 1e-6):
-                continue
-            worst = max(worst, abs(c.solve(Tj) - theta))
-        if worst < THETA_TOL:
-            return theta, rounds
-    raise ContactFailure(f"coning: slice twists differ by up to {worst / ARCMIN:.2e} arcmin from "
-                         f"the combined twist after {MAX_REFINE} refinements")
+    return Slice(push, model, {1: mounted.solution.active, -1: mounted.solution.active})
 
 
 @dataclass
@@ -197,23 +170,24 @@ class ConedResult:
     reason: str
     pushes: tuple
     levels: int
-    rounds: int
+    evaluations: int
 
 
-def combine(curves: dict, coning: float, n_slices: int, test_torque: float) -> ConedResult:
-    """Phi of ``n_slices`` slices at coning slope ``coning`` from the slice curves (keyed by
-    rounded push; refined in place)."""
-    ks = slice_pushes(coning, n_slices)
-    sl = [curves[round(float(k), 9)] for k in ks]
+def combine(slices: list[Slice], test_torque: float) -> ConedResult:
+    """Phi of the slices in parallel: the common twists at +-``test_torque`` (N mm)."""
+    pushes = tuple(s.push for s in slices)
+
+    def torque_at(theta: float) -> float:
+        return float(np.mean([s.torque_at(theta) for s in slices]))
+
     try:
-        tp, rp = coupled_twist(sl, test_torque)
-        tm, rm = coupled_twist(sl, -test_torque)
-    except ContactFailure as exc:
-        return ConedResult(math.nan, math.nan, math.nan, "failed", f"ContactFailure: {exc}",
-                           tuple(ks), sum(c.levels for c in sl), 0)
-    # the first state (+bias) cancels in Phi = theta(+T) - theta(-T)
-    return ConedResult((tp - tm) / ARCMIN, tp / ARCMIN, -tm / ARCMIN, "ok", "", tuple(ks),
-                       sum(c.levels for c in sl), rp + rm)
+        tp, ep = twist_at_torque(torque_at, test_torque, FIRST_STEP)
+        tm, em = twist_at_torque(torque_at, -test_torque, FIRST_STEP)
+    except (ContactFailure, ValueError) as exc:
+        return ConedResult(math.nan, math.nan, math.nan, "failed", f"{type(exc).__name__}: {exc}",
+                           pushes, sum(s.levels for s in slices), 0)
+    return ConedResult((tp - tm) / ARCMIN, tp / ARCMIN, -tm / ARCMIN, "ok", "", pushes,
+                       sum(s.levels for s in slices), ep + em)
 
 
 def solve_coned(geom: DriveGeometry, mesh: DriveMesh, cases: list[tuple[float, int]],
@@ -234,7 +208,7 @@ def solve_coned(geom: DriveGeometry, mesh: DriveMesh, cases: list[tuple[float, i
         Half width of the watched tooth zones (every tooth by default).
     changes : ModelChanges, optional
         Effects of the model (e.g. the flank layer), as for ``solve_lost_motion``; the geometry
-        carries their part already (``ModelChanges.geometry_part``).
+        carries their part already (``ModelChanges.geometry_part``).  Frictionless only.
 
     Returns
     -------
@@ -246,14 +220,14 @@ def solve_coned(geom: DriveGeometry, mesh: DriveMesh, cases: list[tuple[float, i
     except Exception as exc:   # any failure is reported, never a silent number
         return [ConedResult(math.nan, math.nan, math.nan, "failed", f"{type(exc).__name__}: {exc}",
                             (), 0, 0) for _ in cases]
-    curves, failed = {}, {}
+    slices, failed = {}, {}
     for c, n in cases:
         for k in slice_pushes(c, n):
             key = round(float(k), 9)
-            if key in curves or key in failed:
+            if key in slices or key in failed:
                 continue
             try:
-                curves[key] = build_slice(base, geom, key)
+                slices[key] = build_slice(base, key)
             except Exception as exc:
                 failed[key] = f"{type(exc).__name__}: {exc} (slice push {key:.4f})"
     out = []
@@ -263,5 +237,5 @@ def solve_coned(geom: DriveGeometry, mesh: DriveMesh, cases: list[tuple[float, i
         if bad:
             out.append(ConedResult(math.nan, math.nan, math.nan, "failed", bad[0], tuple(keys), 0, 0))
         else:
-            out.append(combine(curves, c, n, geom.torque))
+            out.append(combine([slices[k] for k in keys], geom.torque))
     return out

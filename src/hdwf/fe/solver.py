@@ -24,6 +24,11 @@ taken: as in a primal active-set method the step stops where the first open pair
 (ratio test), that pair enters the active set and nothing is dropped.
 Around the PDAS, the Hertz secants s_ball of the balls are iterated to 0.1 % of the ball
 loads, and with flank friction the stick/slip states of the tooth pairs (``friction``).
+A level is solved at a torque (load control) or at a prescribed rim twist (``Twist``,
+displacement control): the torque is then one more unknown, T u_T its displacement (u_T the
+unit-torque response), with the equation q^T u = theta; scaled by the rim's load factor that
+row is the transpose of its column, so the KKT system stays symmetric.  A preloaded section
+that snaps between two equilibria under a torque has one state at a twist.
 Cost: one factorisation per body plus back-solves, a handful of dense KKT solves per
 load step.  A level that does not converge raises ``ContactFailure``.
 """
@@ -36,8 +41,9 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.linalg import cho_factor, cho_solve
 
+from hdwf.drive.geometry import ARCMIN
 from hdwf.fe.contact_rows import PairId, Rows, stack_rows
-from hdwf.fe.friction import (FRICTION_MAX_IT, ActiveBlock, FlankLaw, FrictionLevel,
+from hdwf.fe.friction import (FRICTION_MAX_IT, ActiveBlock, FlankLaw, FrictionLevel, NoFriction,
                               FrictionlessLevel)
 from hdwf.fe.structure import ModeName, RigidModes, Structure
 from hdwf.fe.working_set import ProjectedColumns, WorkingSet
@@ -49,6 +55,19 @@ Level = FrictionlessLevel | FrictionLevel
 
 class ContactFailure(RuntimeError):
     """The contact problem of a load level did not converge."""
+
+
+@dataclass(frozen=True)
+class Twist:
+    """A prescribed rim twist (rad): the level's torque is then an unknown (displacement control)."""
+    rad: float
+
+
+def describe(load: "float | Twist") -> str:
+    """A level's load for messages: its torque (N m) or its prescribed twist (arcmin)."""
+    if isinstance(load, Twist):
+        return f"twist={load.rad / ARCMIN:.4g} arcmin"
+    return f"T={load / 1000:.4g} N m"
 
 
 @dataclass(frozen=True)
@@ -80,6 +99,7 @@ class LevelSolution:
     pair_ids: list[PairId]
     twist: float                  # rim twist q^T u (rad)
     active: frozenset[PairId]     # pairs in contact (warm start of the next level)
+    torque: float = float("nan")  # torque on the rim (N mm): given, or solved for at a ``Twist``
 
 
 @dataclass(frozen=True)
@@ -95,11 +115,14 @@ class _LevelProblem:
     modes: RigidModes
     mode_names: list[ModeName]
     mode_gap_rates: np.ndarray    # GR = G R
+    mode_block: np.ndarray        # E of the KKT system's mode rows (``_control``)
+    mode_target: np.ndarray       # right-hand side of the mode rows beyond -T R^T f
     ball_index: np.ndarray        # positions of the ball pairs in ``ids``
     row_compliance: np.ndarray    # constant compliance in series with each pair (flank layer)
     u_start: np.ndarray           # last level's displacement (or the free torque response)
     free_gap: np.ndarray          # g0 + G u_start
     projected: ProjectedColumns   # G K^-1 G_W^T, the gaps of a frictionless iterate
+    label: str                    # the load, for messages (``describe``)
 
 
 @dataclass(frozen=True)
@@ -149,8 +172,8 @@ class ContactSolver:
 
     # ---------------------------------------------------------------- one load level
     def solve_level(self, structure: Structure, rows: dict[str, Rows], modes: list[ModeName],
-                    torque: float, active: frozenset[PairId] | None) -> LevelSolution:
-        """Solve the contact problem at one torque (N mm), warm-started from ``active``
+                    torque: "float | Twist", active: frozenset[PairId] | None) -> LevelSolution:
+        """Solve the contact problem at one torque (N mm) or prescribed twist, warm-started from ``active``
         (and the last displacement); Hertz secants of the balls iterated to 0.1 %, and the
         stick/slip states of the flanks with friction.
 
@@ -162,8 +185,9 @@ class ContactSolver:
             Every contact row, by kind.
         modes : list of (body, mode)
             The free rigid modes.
-        torque : float
-            Torque on the FS rim (N mm).
+        torque : float or Twist
+            Torque on the FS rim (N mm), or the rim twist (``Twist``; needs the FS rotation
+            among ``modes`` and frictionless flanks): the torque is then solved for.
         active : frozenset, optional
             Pairs in contact at the start (the last level's ``active``).
 
@@ -183,26 +207,53 @@ class ContactSolver:
                 break
         else:
             raise ContactFailure("flank friction: stick/slip states did not settle in "
-                                 f"{FRICTION_MAX_IT} iterations at T={torque / 1000:.4g} N m")
+                                 f"{FRICTION_MAX_IT} iterations at {describe(torque)}")
         self.friction.finish_level(level)
         self.last_u = outcome.u
         return self._solution(problem, outcome, act, level)
 
     def _level_problem(self, structure: Structure, rows: dict[str, Rows],
-                       modes: list[ModeName], torque: float) -> _LevelProblem:
+                       modes: list[ModeName], load: "float | Twist") -> _LevelProblem:
         stacked = stack_rows(rows)
         G, g0, ids = stacked.G, stacked.g0, stacked.ids
-        rigid = structure.rigid_modes(modes)
+        rigid, block, target, torque = self._control(structure, modes, load)
         u0 = torque * structure.unit_torque_u_watch if self.last_u is None else self.last_u
         if self.projected is None or not _same_rows(self.projected.G, G):
             self.projected = ProjectedColumns(G)
         return _LevelProblem(
             structure=structure, rows=rows, torque=torque, G=G, g0=g0, ids=ids,
             id_position={i: j for j, i in enumerate(ids)}, modes=rigid, mode_names=modes,
-            mode_gap_rates=G @ rigid.watch,
+            mode_gap_rates=G @ rigid.watch, mode_block=block, mode_target=target,
             ball_index=np.array([j for j, (k, _) in enumerate(ids) if k == "ball"]),
             row_compliance=stacked.compliance,
-            u_start=u0, free_gap=g0 + G @ u0, projected=self.projected)
+            u_start=u0, free_gap=g0 + G @ u0, projected=self.projected, label=describe(load))
+
+    def _control(self, structure: Structure, modes: list[ModeName], load: "float | Twist"
+                 ) -> tuple[RigidModes, np.ndarray, np.ndarray, float]:
+        """The free modes, the KKT mode block E, the mode rows' target and the known torque.
+
+        At a torque: E = -1e-14 I (keeps unheld, unloaded modes at zero), no target.  At a
+        ``Twist``: the torque is one more mode, T u_T on the watch dofs, and the known torque
+        is 0; its row is f_scale (q^T u - theta) = 0, whose entries are those of its column
+        (G u_T = f_scale q^T K^-1 G^T, and R^T f = f_scale q^T R per unit torque), with
+        f_scale q^T u_T on the diagonal."""
+        rigid = structure.rigid_modes(modes)
+        nm = len(modes)
+        if not isinstance(load, Twist):
+            return rigid, -1e-14 * np.eye(nm), np.zeros(nm), float(load)
+        if ("fs", "rot") not in modes:
+            raise ValueError("a prescribed twist needs the FS rotation among the free modes")
+        if not isinstance(self.friction, NoFriction):
+            raise ValueError("a prescribed twist is solved for frictionless flanks only")
+        block = np.zeros((nm + 1, nm + 1))
+        block[:nm, :nm] = -1e-14 * np.eye(nm)
+        block[:nm, nm] = block[nm, :nm] = rigid.load
+        block[nm, nm] = structure.f_scale * structure.unit_torque_twist
+        target = np.zeros(nm + 1)
+        target[nm] = structure.f_scale * load.rad
+        torque_mode = RigidModes(np.column_stack([rigid.watch, structure.unit_torque_u_watch]),
+                                 np.append(rigid.twist, structure.unit_torque_twist), np.zeros(nm + 1))
+        return torque_mode, block, target, 0.0
 
     def _solution(self, problem: _LevelProblem, outcome: _ActiveSetOutcome, act: set[PairId],
                   level: Level) -> LevelSolution:
@@ -215,8 +266,10 @@ class ContactSolver:
                  + (ws.twist_columns[wp] @ pw if wp.size else 0.0) + problem.modes.twist @ outcome.alpha)
         fw = np.array([ft[idpos[i]] for i in ids if i in ws.position])
         twist = level.add_slip_twist(twist, wp, fw)
+        torque = (problem.torque if problem.mode_block.shape[0] == len(problem.mode_names)
+                  else float(outcome.alpha[-1]))          # a Twist: the torque mode's amplitude
         return LevelSolution(p_full, ft, outcome.alpha, outcome.u, outcome.gap, ids, float(twist),
-                             frozenset(act))
+                             frozenset(act), torque)
 
     def _hertz_loop(self, problem: _LevelProblem, act: set[PairId],
                     level: Level) -> tuple[_ActiveSetOutcome, set[PairId]]:
@@ -235,8 +288,7 @@ class ContactSolver:
             pb = np.where(pb_new > 0, pb_new, pb)
             if not outcome.converged:
                 raise ContactFailure(f"active-set iteration did not converge in "
-                                     f"{self.settings.max_iter} iterations at "
-                                     f"T={problem.torque / 1000:.4g} N m")
+                                     f"{self.settings.max_iter} iterations at {problem.label}")
             if change < 1e-3:
                 break
         else:
@@ -344,7 +396,8 @@ class ContactSolver:
             torque=T, pairs=Al, positions=wp, rows=rows, compliance=C,
             mode_rows=problem.mode_gap_rates[rows],
             scale=np.abs(np.diag(C)).max() if len(Al) else 1.0,
-            gap_rhs=-(problem.g0[rows] + T * Guq[rows]), mode_rhs=-T * problem.modes.load,
+            gap_rhs=-(problem.g0[rows] + T * Guq[rows]),
+            mode_rhs=-T * problem.modes.load + problem.mode_target,
             n_pairs=len(problem.ids))
 
     def _solve_block(self, problem: _LevelProblem, block: ActiveBlock, level: Level, Guq: np.ndarray):
@@ -356,7 +409,7 @@ class ContactSolver:
         system = level.kkt(block)
         nA, nS, nm = len(block.pairs), system.n_tangential, block.mode_rows.shape[1]
         M = system.matrix
-        M[nA + nS:, nA + nS:] = -1e-14 * np.eye(nm)   # keeps unheld, unloaded modes at zero
+        M[nA + nS:, nA + nS:] = problem.mode_block     # (``_control``)
         sol = _solve_kkt(M, system.rhs, nA if isinstance(level, FrictionlessLevel) else None)
         pA, alpha = sol[:nA], sol[nA + nS:]
         p_full = np.zeros(block.n_pairs)
