@@ -12,16 +12,18 @@ Phi = phi + phi'.  The modules, from the bottom up:
 * ``structure``: the bodies seen through the watch vector, the torque load and twist measure;
 * ``contact_geometry`` and ``contact_rows``: closest points and normals on the contact
   surfaces, and the linearised gaps of cam, balls, fit and teeth;
-* ``working_set`` and ``friction``: the cached compliance of the working set, and the flank
-  law (frictionless or Coulomb) with its own cache and stick/slip state;
-* ``solver``: the active-set contact solver of one load level;
+* ``column_store``, ``node_columns``, ``working_set`` and ``friction``: compliance columns kept
+  in chunks a fork shares, the responses kept per tooth node, the cached compliance of the
+  working set, and the flank law (frictionless or Coulomb) with its own cache and stick/slip state;
+* ``solver``: the active-set contact solver of one load level, at a torque or a prescribed twist;
 * ``relinearise``: the tooth and cam rows re-detected at a solved state until they agree;
 * ``model``: ``LostMotionModel``, which assembles the pieces for one design;
 * ``preload``: the preload ramp that mounts preloaded teeth (``DriveGeometry.preloaded``: a flank
   allowance ``interference_m`` or a deeper cam ``deflection_coeff``), and the
   check of the teeth outside the watched zones;
 * ``series``: elements in series between the FS rim and the output (spring, dead band, micro-slip);
-* ``cycle``: the test itself, ``solve_lost_motion`` and ``solve_lost_motion_variants``.
+* ``cycle``: the test itself, ``solve_lost_motion`` and ``solve_lost_motion_variants``;
+* ``coning``: the quasi-3D cup, slices along the face width on one twist (not in the studies).
 
 Half model (``mesh.symmetry == "half"``, hand-written): the drive and its load are
 invariant under the rotation by pi about the axis (even tooth and ball counts, pi-periodic
@@ -31,8 +33,8 @@ body is meshed (``hdwf.drive.mesh``).  The cut is tied (``bodies``), contacts co
 (``cycle``).  Both models give the same Phi to mesh noise (two different gmsh meshes of one
 density).
 
-Approximations (known, small): P1 triangles (Phi of the designs we checked moves by
-< 2 % between 1x and 1.25x the paper's density, see docs/fe-model.md); the fit bins compare the
+Approximations (known): P1 triangles (with preloaded teeth Phi moves by up to about 6 % between
+1x and 1.25x the paper's density, see docs/fe-model.md, "Mesh convergence"); the fit bins compare the
 two surfaces at equal reference angles (their relative slide of ~10 um on a surface slope
 <= 0.017 shifts those gaps by < 0.2 um, the same for every design); ball 0 sits on the
 major axis (one sample of the WG angle).  Friction, cup torsion, housing compliance,
