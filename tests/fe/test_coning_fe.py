@@ -3,12 +3,11 @@
 
 import pytest
 
-from hdwf.drive.geometry import drive_geometry
+from hdwf.drive.geometry import ARCMIN, drive_geometry
 from hdwf.drive.mesh import build_mesh
 from hdwf.fe import solve_lost_motion
 from hdwf.fe.changes import ModelChanges
 from hdwf.fe.coning import THETA_TOL, solve_coned
-from hdwf.drive.geometry import ARCMIN
 
 COARSE = {"elements_over_height": 5, "elements_over_thickness": 3}
 STUDIES = ModelChanges(flank_interference_m=0.3, flank_layer_m=4200.0)   # config.yaml's fe.effects

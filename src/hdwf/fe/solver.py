@@ -123,6 +123,7 @@ class _LevelProblem:
     free_gap: np.ndarray          # g0 + G u_start
     projected: ProjectedColumns   # G K^-1 G_W^T, the gaps of a frictionless iterate
     label: str                    # the load, for messages (``describe``)
+    torque_unknown: bool          # at a ``Twist``: the torque is the last mode amplitude
 
 
 @dataclass(frozen=True)
@@ -226,7 +227,8 @@ class ContactSolver:
             mode_gap_rates=G @ rigid.watch, mode_block=block, mode_target=target,
             ball_index=np.array([j for j, (k, _) in enumerate(ids) if k == "ball"]),
             row_compliance=stacked.compliance,
-            u_start=u0, free_gap=g0 + G @ u0, projected=self.projected, label=describe(load))
+            u_start=u0, free_gap=g0 + G @ u0, projected=self.projected, label=describe(load),
+            torque_unknown=isinstance(load, Twist))
 
     def _control(self, structure: Structure, modes: list[ModeName], load: "float | Twist"
                  ) -> tuple[RigidModes, np.ndarray, np.ndarray, float]:
@@ -266,8 +268,7 @@ class ContactSolver:
                  + (ws.twist_columns[wp] @ pw if wp.size else 0.0) + problem.modes.twist @ outcome.alpha)
         fw = np.array([ft[idpos[i]] for i in ids if i in ws.position])
         twist = level.add_slip_twist(twist, wp, fw)
-        torque = (problem.torque if problem.mode_block.shape[0] == len(problem.mode_names)
-                  else float(outcome.alpha[-1]))          # a Twist: the torque mode's amplitude
+        torque = float(outcome.alpha[-1]) if problem.torque_unknown else problem.torque
         return LevelSolution(p_full, ft, outcome.alpha, outcome.u, outcome.gap, ids, float(twist),
                              frozenset(act), torque)
 
