@@ -49,6 +49,11 @@ class ModelChanges:
       pressure), in series with every tooth pair over its share of the flank (``contact_rows``).
       It stands for compliance under each tooth that a plane section lacks (the 3D cup and
       face); the mesh is unchanged, the solve carries it (``DriveGeometry.flank_layer_um_per_MPa``).
+    * ``coning_slope``: the FS cup's coning c = b / z_0: the wave generator's push grows as
+      w0 (1 + c zeta) across the face width (zeta = 0 at the diaphragm end), solved as
+      ``coning_slices`` sections in parallel on one twist (``hdwf.fe.coning``; 0 = the uniform
+      section).  Eight slices: doubling them moves Phi by less than 1 % on every design of
+      Tables 4/5 (docs/fe-model.md, "Coning").
     """
     flank_friction: float = 0.0
     cs_rim_stiffness_N_mm2: float = math.inf
@@ -58,6 +63,8 @@ class ModelChanges:
     output_microslip_loop_rad: float = 0.0
     flank_interference_m: float = 0.0
     flank_layer_m: float = 0.0
+    coning_slope: float = 0.0
+    coning_slices: int = 8
 
     def layer_um_per_MPa(self, module_mm: float, E_MPa: float) -> float:
         """The flank layer's compliance (um per MPa) of a drive of this module and modulus."""

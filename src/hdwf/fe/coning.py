@@ -1,4 +1,4 @@
-"""Coning (quasi-3D prototype): the section solved at N slices along the face width, in parallel.
+"""Coning (quasi-3D): the section solved at N slices along the face width, in parallel.
 
 What it models.  A flexspline cup is held circular by its diaphragm, so the radial
 deflection the wave generator imposes grows (to first order linearly) with the distance z
@@ -32,6 +32,13 @@ twist at +-T is found on the path from the mount, theta growing in the torque's 
 steps until T(theta) passes the torque, then regula falsi (Illinois) to ``THETA_TOL``;
 Phi = theta(+T) - theta(-T).
 
+In the model.  ``ModelChanges.coning_slope`` c (with ``coning_slices`` N) routes
+``solve_lost_motion`` here (``coned_lost_motion``): every level of the test's path is the twist
+at that torque (frictionless, a state does not depend on its path), the zero-torque levels at
+``cycle.ZERO_TORQUE_BIAS`` T towards the last load as in the section's test; series elements
+act on the twist as there.  The effect ``coning`` (``hdwf.validation.effects``) offers it to a
+campaign.
+
 What it neglects.  The slices exchange no shear (a continuous cup couples neighbouring
 sections; a plane-stress section at each z is the classic multi-section / "quasi-3D"
 approximation), the cup's torsion between the slices and the output (every slice's rim is
@@ -43,6 +50,7 @@ relief are the same in every slice (no profile modification along the face).
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
@@ -52,7 +60,8 @@ from hdwf.drive.cam import cam_for_push
 from hdwf.drive.geometry import ARCMIN, DriveGeometry
 from hdwf.drive.mesh import DriveMesh
 from hdwf.fe.changes import ModelChanges
-from hdwf.fe.cycle import mount_wave_generator
+from hdwf.fe.cycle import (ZERO_TORQUE_BIAS, LostMotionResult, MountedWaveGenerator, TorqueTest, failed_result,
+                           lost_motion_result, mount_wave_generator, teeth_in_contact, torque_fractions)
 from hdwf.fe.model import LostMotionModel
 from hdwf.fe.preload import PRELOAD_ZONE_DEG
 from hdwf.fe.relinearise import GEO_MAX_IT, GEO_TOL, settle
@@ -128,6 +137,7 @@ class Slice:
     at the twists asked (full-section torque T', N mm)."""
     push: float
     model: LostMotionModel
+    mounted: MountedWaveGenerator
     active: dict = field(default_factory=dict)       # side (+1/-1) -> warm-start active set
     torques: dict = field(default_factory=dict)      # twist (rad) -> T'
     levels: int = 0
@@ -136,6 +146,10 @@ class Slice:
         """T' at rim twist ``theta`` (rad): solved on a fork of the mount and settled."""
         if theta in self.torques:
             return self.torques[theta]
+        return self.state_at(theta)[1].torque
+
+    def state_at(self, theta: float):
+        """(the fork it was solved on, the settled level) at rim twist ``theta`` (rad)."""
         side = 1 if theta >= 0 else -1
         at = self.model.fork()
         level = at.solve_level(Twist(theta), self.active[side])
@@ -147,7 +161,7 @@ class Slice:
         self.active[side] = level.active
         self.levels += 1
         self.torques[theta] = level.torque
-        return level.torque
+        return at, level
 
 
 def build_slice(base: LostMotionModel, push: float) -> Slice:
@@ -157,7 +171,7 @@ def build_slice(base: LostMotionModel, push: float) -> Slice:
     model.geometry = coned_geometry(base.geometry, push)    # (with the base's flank layer)
     mounted = mount_wave_generator(model, True)
     model.mode_list = model.mode_list + [("fs", "rot")]
-    return Slice(push, model, {1: mounted.solution.active, -1: mounted.solution.active})
+    return Slice(push, model, mounted, {1: mounted.solution.active, -1: mounted.solution.active})
 
 
 @dataclass
@@ -239,3 +253,73 @@ def solve_coned(geom: DriveGeometry, mesh: DriveMesh, cases: list[tuple[float, i
         else:
             out.append(combine([slices[k] for k in keys], geom.torque))
     return out
+
+
+def coned_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int,
+                      changes: ModelChanges, zone_deg: float | None = None,
+                      keep_fields: bool = False) -> LostMotionResult:
+    """The lost-motion test of the coned cup (``changes.coning_slope`` c, ``coning_slices`` N):
+    the section's result (``cycle.LostMotionResult``) with the slices in parallel.
+
+    Every level of 0 -> +T -> 0 -> -T -> 0 is the common twist at which the slices' torques
+    add up to that level's torque (``twist_at_torque``).  The record of the mount (the wave
+    generator's push, the most loaded ball) is the open-end slice's, the most pushed; the teeth in
+    contact, their loaded arc and the tooth penetration are the largest over the slices at +T,
+    each slice solved again at the twist found; ``keep_fields`` keeps the open-end slice's
+    displacements (``wg``, ``plus``).  Frictionless only.  Any failure gives status "failed" and
+    no number.
+    """
+    t0 = time.perf_counter()
+    frac = torque_fractions(steps_per_ramp)
+    last = None
+    try:
+        if changes.flank_friction > 0:
+            raise ValueError("coning is solved at prescribed twists, frictionless only "
+                             f"(flank_friction = {changes.flank_friction})")
+        if changes.coning_slices < 1:
+            raise ValueError(f"coning_slices must be at least 1, not {changes.coning_slices}")
+        section = replace(changes, coning_slope=0.0, coning_slices=1)
+        base = LostMotionModel(geom, mesh, changes=section,
+                               zone_deg=PRELOAD_ZONE_DEG if zone_deg is None else zone_deg)
+        slices = [build_slice(base, float(k))
+                  for k in slice_pushes(changes.coning_slope, changes.coning_slices)]
+        last = slices[-1]
+
+        def torque_at(theta: float) -> float:
+            return float(np.mean([s.torque_at(theta) for s in slices]))
+
+        twists, found, sign = [], {}, 1.0
+        for fraction in frac:
+            if abs(fraction) > 1e-12:
+                sign = math.copysign(1.0, fraction)
+                target = fraction * geom.torque
+            else:
+                target = ZERO_TORQUE_BIAS * geom.torque * sign
+            if target not in found:
+                found[target] = twist_at_torque(torque_at, target, FIRST_STEP)[0]
+            twists.append(found[target])
+        test = _plus_record(slices, found[geom.torque], np.array(twists), keep_fields)
+        res = lost_motion_result(last.model, changes, frac, last.mounted, test, t0)
+    except Exception as exc:   # any failure is reported, never a silent number
+        return failed_result(exc, last.model if last is not None else None, t0)
+    levels = sum(s.levels for s in slices)
+    return replace(res, iterations=sum(s.model.iterations for s in slices),
+                   notes=res.notes + f"; coned cup: slope {changes.coning_slope:g}, "
+                   f"{changes.coning_slices} slices (pushes {slices[0].push:.4f}-{last.push:.4f} w0), "
+                   f"{levels} slice states solved")
+
+
+def _plus_record(slices: list[Slice], theta_plus: float, twists: np.ndarray, keep_fields: bool) -> TorqueTest:
+    """The checks of the test at +T: every slice solved at the twist found there."""
+    teeth, arc, pen, fields = 0, float("nan"), 0.0, None
+    for s in slices:
+        at, level = s.state_at(theta_plus)
+        kinds = np.array([i[0] for i in level.pair_ids])
+        count, a = teeth_in_contact(at, level, kinds)
+        teeth = max(teeth, count)
+        arc = a if math.isnan(arc) else max(arc, a)
+        pen = max(pen, float(-(level.gap[kinds != "ball"]).min(initial=0.0)))
+        if keep_fields and s is slices[-1]:
+            fields = {"wg": s.model.full_displacements(s.mounted.solution, 0.0),
+                      "plus": at.full_displacements(level, level.torque)}
+    return TorqueTest(twists, pen, pen, teeth, arc, fields)

@@ -82,7 +82,7 @@ class LostMotionResult:
 
 
 @dataclass(frozen=True)
-class _MountedWaveGenerator:
+class MountedWaveGenerator:
     """Stage 1 solved: the contact solution and the FS bore's radial push at the major axis."""
     solution: LevelSolution
     deflection_um: float
@@ -91,7 +91,7 @@ class _MountedWaveGenerator:
 
 
 @dataclass(frozen=True)
-class _TorqueTest:
+class TorqueTest:
     """Stage 2 solved: rim twists (rad) and the checks of the contact solution."""
     twists: np.ndarray
     max_penetration: float             # mm, over every level (balls excluded)
@@ -110,7 +110,7 @@ def torque_fractions(steps_per_ramp: int) -> np.ndarray:
 
 
 def mount_wave_generator(model: LostMotionModel,
-                          ramp_teeth: bool = False) -> _MountedWaveGenerator:
+                          ramp_teeth: bool = False) -> MountedWaveGenerator:
     """Stage 1: the wave generator pushed into the FS (no teeth), FS rotation pinned; with
     ``ramp_teeth`` the teeth are then ramped in (``preload.mount_preloaded``)."""
     geom = model.geometry
@@ -141,11 +141,11 @@ def mount_wave_generator(model: LostMotionModel,
         state, preload = mount_with_cutback(model, state)
         u = state.u_watch
         preload["wg_retreat_um"] = (free_deflection - float(u[j0])) * 1000.0
-    return _MountedWaveGenerator(state, float(u[j0]) * 1000.0, preload,
+    return MountedWaveGenerator(state, float(u[j0]) * 1000.0, preload,
                                  overlap_outside_zones(model, state) * 1000.0)
 
 
-def _teeth_in_contact(model: LostMotionModel, level: LevelSolution, kinds: np.ndarray) -> tuple[int, float]:
+def teeth_in_contact(model: LostMotionModel, level: LevelSolution, kinds: np.ndarray) -> tuple[int, float]:
     """FS teeth with a loaded pair (both halves counted in the half model), and the largest
     angle (deg) of one of them from the nearer major axis: a loaded tooth far out in the exit
     zone (beyond ``EXIT_ARC_DEG``) is a tip crossing, not the working mesh."""
@@ -161,8 +161,8 @@ def _teeth_in_contact(model: LostMotionModel, level: LevelSolution, kinds: np.nd
     return count, arc
 
 
-def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWaveGenerator,
-                 fields: dict | None) -> _TorqueTest:
+def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: MountedWaveGenerator,
+                 fields: dict | None) -> TorqueTest:
     """Stage 2: teeth at the deflected configuration, FS rotation free, the torque sequence."""
     geom = model.geometry
     Tn = geom.torque
@@ -207,12 +207,14 @@ def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: _MountedWave
         if abs(fraction - 1.0) < 1e-12:
             if fields is not None and "plus" not in fields:
                 fields["plus"] = at.full_displacements(level, T)
-            tooth_count, arc = _teeth_in_contact(at, level, kinds)
-    return _TorqueTest(np.array(twists), maxpen, maxpen_nl, tooth_count, arc, fields)
+            tooth_count, arc = teeth_in_contact(at, level, kinds)
+    return TorqueTest(np.array(twists), maxpen, maxpen_nl, tooth_count, arc, fields)
 
 
-def _result(model: LostMotionModel, changes: ModelChanges, frac: np.ndarray,
-            mounted: _MountedWaveGenerator, test: _TorqueTest, t0: float) -> LostMotionResult:
+def lost_motion_result(model: LostMotionModel, changes: ModelChanges, frac: np.ndarray,
+                       mounted: MountedWaveGenerator, test: TorqueTest, t0: float) -> LostMotionResult:
+    """The result of a solved test: the curve at the output (series elements of ``changes`` added),
+    Phi, and the record of the mount and the test."""
     Tn = model.geometry.torque
     tw = series_output_twist(test.twists, frac * Tn, changes) / ARCMIN
     tw = tw - tw[0]
@@ -248,7 +250,8 @@ def _preload_note(preload: dict | None) -> str:
             + f", re-detected penetration at the mount {preload['penetration_um']:.4f} um")
 
 
-def _failed(exc: Exception, model: LostMotionModel | None, t0: float) -> LostMotionResult:
+def failed_result(exc: Exception, model: LostMotionModel | None, t0: float) -> LostMotionResult:
+    """Status "failed" with the exception as the reason, and no number."""
     nan, empty = float("nan"), np.array([])
     return LostMotionResult(
         phi_plus_arcmin=nan, phi_minus_arcmin=nan, lost_motion_arcmin=nan,
@@ -315,6 +318,8 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
     """
     changes = ModelChanges() if changes is None else changes
     _check_geometry(geom, changes)
+    if changes.coning_slope != 0.0:
+        return _coned(geom, mesh, steps_per_ramp, changes, zone_deg, keep_fields)
     t0 = time.perf_counter()
     frac = torque_fractions(steps_per_ramp)
     model = None
@@ -327,9 +332,9 @@ def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int 
         mounted = mount_wave_generator(model, ramp)
         fields = {"wg": model.full_displacements(mounted.solution, 0.0)} if keep_fields else None
         test = _torque_test(model, frac, mounted, fields)
-        return _result(model, changes, frac, mounted, test, t0)
+        return lost_motion_result(model, changes, frac, mounted, test, t0)
     except Exception as exc:   # any failure is reported, never a silent number
-        return _failed(exc, model, t0)
+        return failed_result(exc, model, t0)
 
 
 def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int,
@@ -360,6 +365,15 @@ def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_r
     """
     for ch in variants:
         _check_geometry(geom, ch)
+    if any(ch.coning_slope != 0.0 for ch in variants):
+        # the coned cup mounts its own slices: solved apart, once per contact model
+        coned = {ch.fe_part(): _coned(geom, mesh, steps_per_ramp, ch.fe_part())
+                 for ch in variants if ch.coning_slope != 0.0}
+        rest = [ch for ch in variants if ch.coning_slope == 0.0]
+        solved = dict(zip(rest, solve_lost_motion_variants(geom, mesh, steps_per_ramp, rest, shared)
+                          if rest else []))
+        return [solved[ch] if ch.coning_slope == 0.0 else _with_series(coned[ch.fe_part()], ch)
+                for ch in variants]
     if geom.preloaded:
         return _preloaded_variants(geom, mesh, steps_per_ramp, variants, shared)
     t0 = time.perf_counter()
@@ -369,7 +383,7 @@ def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_r
         base = LostMotionModel(geom, mesh, shared=shared)
         mounted = mount_wave_generator(base)
     except Exception as exc:
-        failed = _failed(exc, base, t0)
+        failed = failed_result(exc, base, t0)
         return [failed for _ in variants]
     out, solved = [], {}
     for ch in variants:
@@ -381,10 +395,28 @@ def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_r
                 model.apply_tooth_stage_changes(ch.fe_part())
                 solved[ch.fe_part()] = (model, _torque_test(model, frac, mounted, None))
             model, test = solved[ch.fe_part()]
-            out.append(_result(model, ch, frac, mounted, test, t1))
+            out.append(lost_motion_result(model, ch, frac, mounted, test, t1))
         except Exception as exc:
-            out.append(_failed(exc, model, t1))
+            out.append(failed_result(exc, model, t1))
     return out
+
+
+def _coned(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int, changes: ModelChanges,
+           zone_deg: float | None = None, keep_fields: bool = False) -> LostMotionResult:
+    # imported here: hdwf.fe.coning builds on this module's mount and test
+    from hdwf.fe.coning import coned_lost_motion
+    return coned_lost_motion(geom, mesh, steps_per_ramp, changes, zone_deg, keep_fields)
+
+
+def _with_series(res: LostMotionResult, changes: ModelChanges) -> LostMotionResult:
+    """A result of the contact model ``changes.fe_part()`` with ``changes``' series elements."""
+    if res.status != "ok" or changes == changes.fe_part():
+        return res
+    tw = series_output_twist(res.twist_arcmin * ARCMIN, res.torque_Nm * 1000.0, changes) / ARCMIN
+    tw = tw - tw[0]
+    kp, km = int(np.argmax(res.torque_Nm)), int(np.argmin(res.torque_Nm))
+    return replace(res, twist_arcmin=tw, phi_plus_arcmin=float(tw[kp]), phi_minus_arcmin=float(-tw[km]),
+                   lost_motion_arcmin=float(tw[kp] - tw[km]))
 
 
 def _preloaded_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int,
@@ -411,8 +443,8 @@ def _preloaded_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: in
                     exc = err
             solved[key] = (model, mounted, test if exc is None else None, exc)
         model, mounted, test, exc = solved[key]
-        out.append(_failed(exc, model, t1) if exc is not None
-                   else _result(model, ch, frac, mounted, test, t1))
+        out.append(failed_result(exc, model, t1) if exc is not None
+                   else lost_motion_result(model, ch, frac, mounted, test, t1))
     return out
 
 
