@@ -141,6 +141,7 @@ class Slice:
     active: dict = field(default_factory=dict)       # side (+1/-1) -> warm-start active set
     torques: dict = field(default_factory=dict)      # twist (rad) -> T'
     levels: int = 0
+    state_iterations: int = 0                        # active-set iterations of the states solved
 
     def torque_at(self, theta: float) -> float:
         """T' at rim twist ``theta`` (rad): solved on a fork of the mount and settled."""
@@ -152,14 +153,19 @@ class Slice:
         """(the fork it was solved on, the settled level) at rim twist ``theta`` (rad)."""
         side = 1 if theta >= 0 else -1
         at = self.model.fork()
-        level = at.solve_level(Twist(theta), self.active[side])
-        level, err, ok = settle(at, level, Twist(theta), GEO_TOL)
+        # from the mount's zero twist in up to two halvings if the active set cycles
+        try:
+            level = at.solve_level_stepped(Twist(theta), self.active[side], Twist(0.0))
+            level, err, ok = settle(at, level, Twist(theta), GEO_TOL, from_load=Twist(0.0))
+        except ContactFailure as exc:
+            raise ContactFailure(f"coning: slice k={self.push:.4f}: {exc}") from exc
         if not ok:
             raise ContactFailure(f"coning: slice k={self.push:.4f} at {theta / ARCMIN:.4g} arcmin: "
                                  f"tooth gaps {err * 1000:.3f} um off their linearisation after "
                                  f"{GEO_MAX_IT} re-linearisations")
         self.active[side] = level.active
         self.levels += 1
+        self.state_iterations += at.iterations - self.model.iterations
         self.torques[theta] = level.torque
         return at, level
 
@@ -303,7 +309,7 @@ def coned_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int,
     except Exception as exc:   # any failure is reported, never a silent number
         return failed_result(exc, last.model if last is not None else None, t0)
     levels = sum(s.levels for s in slices)
-    return replace(res, iterations=sum(s.model.iterations for s in slices),
+    return replace(res, iterations=sum(s.model.iterations + s.state_iterations for s in slices),
                    notes=res.notes + f"; coned cup: slope {changes.coning_slope:g}, "
                    f"{changes.coning_slices} slices (pushes {slices[0].push:.4f}-{last.push:.4f} w0), "
                    f"{levels} slice states solved")

@@ -24,6 +24,9 @@ use 1e-3 of the test torque in the direction of the last load (the state an
 infinitesimally small friction would leave), documented in the result.  Curve twists are
 relative to the first (+0) state.  In the half model every tooth in contact has its image
 at +pi, so the count of teeth in contact is doubled.
+
+A coned cup (``ModelChanges.coning_slope`` not 0) is solved by ``hdwf.fe.coning`` as slices in
+parallel; its result has the same form.
 """
 
 from __future__ import annotations

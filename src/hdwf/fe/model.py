@@ -22,7 +22,7 @@ from hdwf.fe.contact_rows import Rows, stack_rows
 from hdwf.fe.friction import flank_law
 from hdwf.fe.hertz import ball_compliance_coeff
 from hdwf.fe.node_columns import PATTERN_BODIES, NodeColumns
-from hdwf.fe.solver import TOL_GAP, ContactFailure, ContactSolver, LevelSolution, SolverSettings
+from hdwf.fe.solver import TOL_GAP, ContactFailure, ContactSolver, LevelSolution, SolverSettings, Twist
 from hdwf.fe.structure import ModeName, Structure
 from hdwf.fe.working_set import WorkingSet
 
@@ -214,23 +214,24 @@ class LostMotionModel:
         self.rows[kind] = rows
         self.solver.refresh(self.structure, self.rows, kind)
 
-    def solve_level(self, torque: float, active: frozenset | None) -> LevelSolution:
-        """The contact solution at ``torque`` (N mm), warm-started from ``active``."""
+    def solve_level(self, torque: float | Twist, active: frozenset | None) -> LevelSolution:
+        """The contact solution at ``torque`` (N mm) or a prescribed ``Twist``, warm-started from ``active``."""
         return self.solver.solve_level(self.structure, self.rows, self.mode_list, torque, active)
 
-    def solve_level_stepped(self, torque: float, active: frozenset | None, from_torque: float,
+    def solve_level_stepped(self, torque: float | Twist, active: frozenset | None, from_torque: float | Twist,
                             cutbacks: int = LEVEL_CUTBACKS) -> LevelSolution:
-        """``solve_level``; if it fails (an active set that cycles), the torque halfway from
-        ``from_torque`` (the last level's) is solved first and this one from there, as an FE code
-        cuts back a load step, at most ``cutbacks`` halvings deep.  A failed solve leaves the
-        warm start and the friction state of the last level (it commits them only when it
-        converges), so the retry starts where the failed one did."""
+        """``solve_level``; if it fails (an active set that cycles), the load halfway from
+        ``from_torque`` (the last level's: a torque, or a prescribed ``Twist``) is solved first and
+        this one from there, as an FE code cuts back a load step, at most ``cutbacks`` halvings
+        deep.  A failed solve leaves the warm start and the friction state of the last level (it
+        commits them only when it converges), so the retry starts where the failed one did."""
         try:
             return self.solve_level(torque, active)
         except ContactFailure:
             if cutbacks == 0:
                 raise
-            mid = 0.5 * (from_torque + torque)
+            mid = (Twist(0.5 * (from_torque.rad + torque.rad)) if isinstance(torque, Twist)
+                   else 0.5 * (from_torque + torque))
             half = self.solve_level_stepped(mid, active, from_torque, cutbacks - 1)
             return self.solve_level_stepped(torque, half.active, mid, cutbacks - 1)
 

@@ -28,7 +28,7 @@ import scipy.sparse as sp
 
 from hdwf.fe.contact_rows import Rows, cam_rows, tooth_rows
 from hdwf.fe.model import LostMotionModel
-from hdwf.fe.solver import ContactFailure, LevelSolution
+from hdwf.fe.solver import ContactFailure, LevelSolution, Twist
 
 GEO_TOL = 5e-5       # mm: re-detected minus linearised gap of the pairs near contact
 GEO_NEAR = 5e-3      # mm: pairs closer than this count as near contact
@@ -66,15 +66,17 @@ def gap_only(old: Rows, new: Rows, u: np.ndarray) -> Rows:
     return replace(old, g0=old.g0 + (new.g0 + new.G @ u) - (old.g0 + old.G @ u))
 
 
-def settle(model: LostMotionModel, level: LevelSolution, torque: float, tol: float,
-           hold: float = 0.0) -> tuple[LevelSolution, float, bool]:
+def settle(model: LostMotionModel, level: LevelSolution, torque: float | Twist, tol: float,
+           hold: float = 0.0, from_load: float | Twist | None = None) -> tuple[LevelSolution, float, bool]:
     """Re-solve ``level`` (the solution of the model's current rows at ``torque``, N mm)
     with the tooth and cam rows re-detected at the solution until they equal their
     linearisations within ``tol`` (mm).
 
     The tooth rows keep their slave nodes, so a pair keeps its identity (and its cached
     compliance column while its row is unchanged); ``hold`` (mm) is added to every
-    re-detected tooth gap (the preload ramp's overlap not yet ramped in).
+    re-detected tooth gap (the preload ramp's overlap not yet ramped in).  With ``from_load`` a
+    re-solve whose active set cycles is reached from that load in halvings
+    (``LostMotionModel.solve_level_stepped``).
 
     Returns
     -------
@@ -98,7 +100,8 @@ def settle(model: LostMotionModel, level: LevelSolution, torque: float, tol: flo
             model.rows["tooth"] = gap_only(model.rows["tooth"], tooth, u)
             model.rows["cam"] = gap_only(model.rows["cam"], cam, u)
         prev = err
-        level = model.solve_level(torque, level.active)
+        level = (model.solve_level(torque, level.active) if from_load is None
+                 else model.solve_level_stepped(torque, level.active, from_load))
         tooth, cam, err = _redetect(model, level.u_watch, hold)
     return level, err, err < tol
 
