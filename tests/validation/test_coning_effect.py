@@ -57,3 +57,61 @@ def test_a_coned_variant_of_a_campaign_table_takes_series_elements_exactly():
     torque = curves[1]["torque_Nm"].to_numpy()
     np.testing.assert_allclose(cone_cup - cone, (torque - torque[0]) / K / ARCMIN, atol=1e-9)
     assert section[1] > 0 and cone[1] > 0
+
+
+def test_the_shipped_coning_campaigns_are_valid_and_tabulate_coning_on_the_preload():
+    """``workflow/campaigns/paper_coning.yaml`` merged over config.yaml (as ``--configfile``
+    does) passes the schema, and each campaign's table holds its preloaded model, coning at
+    c = 0.2 and 0.4 on that preload, and the other two candidates' grids."""
+    import yaml
+    from snakemake.utils import update_config
+
+    from hdwf.config import SCHEMA_PATH, validate_config
+    from hdwf.stages.validation import campaign_plan
+
+    from conftest import ROOT
+
+    config = yaml.safe_load((ROOT / "config.yaml").read_text())
+    extra = ROOT / "workflow/campaigns/paper_coning.yaml"
+    update_config(config, yaml.safe_load(extra.read_text()))
+    validate_config(config, SCHEMA_PATH, source=[ROOT / "config.yaml", extra])
+    for name, preload in (("paper_hd42_coning", 0.222), ("paper_hd120_coning", 0.186)):
+        variants = campaign_plan(name, config["validation"][name], config["fe"]).table_variants()
+        assert variants[0] == {"preload": {"interference_m": preload}}
+        assert all(v["preload"] == {"interference_m": preload} for v in variants)
+        assert [v["coning"]["slope"] for v in variants if "coning" in v] == pytest.approx([0.2, 0.4])
+        assert {n for v in variants for n in v} == {"preload", "coning", "fs_cup_torsion", "cs_housing"}
+
+
+def test_a_grid_value_failed_on_some_specimens_is_dropped_and_named():
+    """Calibration needs every specimen at a grid value: a value that failed on some is dropped,
+    the note names it and how many specimens failed; with no value left the candidate is not
+    calibrated, and the note says why (not that every solve failed)."""
+    import pandas as pd
+
+    from hdwf.validation.calibration import responses
+    from hdwf.validation.variants import variant_key
+
+    fixed = {"preload": {"interference_m": 0.2}}
+    variants = [fixed] + [{**fixed, "coning": {"slope": c}} for c in (0.2, 0.4)] \
+        + [{**fixed, "oldham_play": {"play_arcsec": a}} for a in (7.5, 15.0, 22.5, 30.0)]
+    failed = {("s1", "coning", 0.2), ("s2", "coning", 0.2), ("s3", "coning", 0.4), ("s1", "oldham_play", 30.0)}
+    rows = []
+    for sid in ("s1", "s2", "s3"):
+        for v in variants:
+            extra = [(n, next(iter(p.values()))) for n, p in v.items() if n != "preload"]
+            bad = bool(extra) and (sid, *extra[0]) in failed
+            for step, frac in enumerate((0.0, 1.0, 0.0, -1.0, 0.0)):
+                rows.append({"specimen_id": sid, "variant": variant_key(v), "step": step, "torque_Nm": 0.96 * frac,
+                             "twist_arcmin": float("nan") if bad else 0.2 * frac, "status": "failed: x" if bad else "ok",
+                             "ball_pressure_max_MPa": 900.0})
+    table = pd.DataFrame(rows)
+    obs = pd.DataFrame({"specimen_id": ["s1", "s2", "s3"], "D": [0.4, 0.5, 0.6], "quantity": "lost_motion",
+                        "u_D": float("nan")})
+    notes = {}
+    resp = responses(table, obs, fixed, ["coning", "oldham_play"], notes)
+    assert "coning" not in resp and "oldham_play" in resp
+    assert notes["coning"] == ("solve failed at slope = 0.2 (2 specimens), 0.4 (1 specimens): "
+                               "no grid value solved for every specimen; not calibrated")
+    assert notes["oldham_play"].startswith("solve failed at play_arcsec = 30 (1 specimens)")
+    assert resp["oldham_play"].t.size == 4      # off and the three values that solved

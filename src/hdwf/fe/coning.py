@@ -152,22 +152,58 @@ class Slice:
     def state_at(self, theta: float):
         """(the fork it was solved on, the settled level) at rim twist ``theta`` (rad)."""
         side = 1 if theta >= 0 else -1
-        at = self.model.fork()
-        # from the mount's zero twist in up to two halvings if the active set cycles
         try:
-            level = at.solve_level_stepped(Twist(theta), self.active[side], Twist(0.0))
-            level, err, ok = settle(at, level, Twist(theta), GEO_TOL, from_load=Twist(0.0))
+            at, level = self._at_twist(theta, side)
         except ContactFailure as exc:
-            raise ContactFailure(f"coning: slice k={self.push:.4f}: {exc}") from exc
-        if not ok:
-            raise ContactFailure(f"coning: slice k={self.push:.4f} at {theta / ARCMIN:.4g} arcmin: "
-                                 f"tooth gaps {err * 1000:.3f} um off their linearisation after "
-                                 f"{GEO_MAX_IT} re-linearisations")
+            # the twist-controlled active set can cycle where a torque-controlled one does not
+            try:
+                at, level = self._at_torque(theta, side)
+            except ContactFailure as retry:
+                raise ContactFailure(f"coning: slice k={self.push:.4f}: {exc}; at a torque: {retry}") from exc
         self.active[side] = level.active
         self.levels += 1
         self.state_iterations += at.iterations - self.model.iterations
         self.torques[theta] = level.torque
         return at, level
+
+    def _settled(self, at: LostMotionModel, level, load):
+        level, err, ok = settle(at, level, load, GEO_TOL)
+        if not ok:
+            raise ContactFailure(f"tooth gaps {err * 1000:.3f} um off their linearisation after "
+                                 f"{GEO_MAX_IT} re-linearisations")
+        return level
+
+    def _at_twist(self, theta: float, side: int):
+        """The state at a prescribed twist, reached from the mount's zero twist in up to two
+        halvings if the active set cycles."""
+        at = self.model.fork()
+        level = at.solve_level_stepped(Twist(theta), self.active[side], Twist(0.0))
+        return at, self._settled(at, level, Twist(theta))
+
+    def _at_torque(self, theta: float, side: int):
+        """The state at ``theta`` found by torque control: the secant on the torque until the
+        settled state's twist is ``theta`` within a tenth of ``THETA_TOL``."""
+        near = sorted(self.torques.items(), key=lambda kv: abs(kv[0] - theta))
+        points = [(th, t) for th, t in near if th * side > 0][:2]
+        if len(points) < 2:    # no slope known on this side: from a small torque and a tenth of the test's
+            t_test = self.model.geometry.torque
+            points = []
+            for T in (side * 1e-3 * t_test, side * 0.1 * t_test):
+                at = self.model.fork()
+                level = self._settled(at, at.solve_level_stepped(T, self.active[side], 0.0), T)
+                points.append((level.twist, T))
+        (th_a, t_a), (th_b, t_b) = points[0], points[1]
+        iterations = 0
+        while True:
+            T = t_b + (theta - th_b) * (t_b - t_a) / (th_b - th_a)
+            at = self.model.fork()
+            level = self._settled(at, at.solve_level_stepped(T, self.active[side], t_b), T)
+            iterations += 1
+            if abs(level.twist - theta) < 0.1 * THETA_TOL:
+                return at, level
+            if iterations == MAX_EVALUATIONS:
+                raise ContactFailure(f"twist {theta / ARCMIN:.4g} arcmin not reached in {iterations} torques")
+            (th_a, t_a), (th_b, t_b) = (th_b, t_b), (level.twist, T)
 
 
 def build_slice(base: LostMotionModel, push: float) -> Slice:

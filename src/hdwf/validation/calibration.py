@@ -112,18 +112,21 @@ def responses(table: pd.DataFrame, obs: pd.DataFrame, fixed: dict, candidates: l
         p = get_effect(name).parameters[0]
         ts, Ss, dropped = [0.0], [S0], []
         for v in p.grid():
-            S = predict(table, obs, variant_key({**fixed, name: {p.name: v}}))
+            key = variant_key({**fixed, name: {p.name: v}})
+            S = predict(table, obs, key)
             if np.isfinite(S).all():
                 ts.append(p.to_t(v))
                 Ss.append(S)
             else:
-                dropped.append(v)
+                rows = table[table["variant"] == key]
+                dropped.append(f"{v:g} ({rows.loc[rows['status'] != 'ok', 'specimen_id'].nunique()} "
+                               "specimens)")
+        failed = f"solve failed at {p.name} = {', '.join(dropped)}"
         if notes is not None and dropped:
-            notes[name] = (f"solve failed at {p.name} = {', '.join(f'{v:g}' for v in dropped)}; "
-                           "calibrated over the values that solved")
+            notes[name] = f"{failed}; calibrated over the values that solved"
         if len(ts) < 2:
             if notes is not None:
-                notes[name] = "every grid solve failed; not calibrated"
+                notes[name] = f"{failed}: no grid value solved for every specimen; not calibrated"
             continue
         order = np.argsort(ts)
         lo, hi = p.t_bounds
