@@ -69,6 +69,10 @@ from hdwf.fe.solver import ContactFailure, Twist
 
 THETA_TOL = 1e-3 * ARCMIN   # rad: the twist at +-T to this (0.3 % of a 0.3 arcmin Phi)
 MAX_EVALUATIONS = 40        # twists tried per torque
+# active-set iterations of a slice state: a slice pushed beyond the design push presses more
+# teeth in, and a re-linearisation at a twist then moves a few hundred pairs across zero, added a
+# few at a time (``solver``): HD 120 slices at 1.1-1.2 w0 on a 0.186 m preload needed more than 200
+SLICE_MAX_ITER = 1000
 FIRST_STEP = 0.02 * ARCMIN  # rad: the first twist tried (a tenth of a preloaded HD 42's Phi/2;
                             # the secant steps grow it at most 4 times a step)
 
@@ -150,60 +154,24 @@ class Slice:
         return self.state_at(theta)[1].torque
 
     def state_at(self, theta: float):
-        """(the fork it was solved on, the settled level) at rim twist ``theta`` (rad)."""
+        """(the fork it was solved on, the settled level) at rim twist ``theta`` (rad), reached
+        from the mount's zero twist in up to two halvings if the active set does not converge."""
         side = 1 if theta >= 0 else -1
+        at = self.model.fork()
         try:
-            at, level = self._at_twist(theta, side)
+            level = at.solve_level_stepped(Twist(theta), self.active[side], Twist(0.0))
+            level, err, ok = settle(at, level, Twist(theta), GEO_TOL)
         except ContactFailure as exc:
-            # the twist-controlled active set can cycle where a torque-controlled one does not
-            try:
-                at, level = self._at_torque(theta, side)
-            except ContactFailure as retry:
-                raise ContactFailure(f"coning: slice k={self.push:.4f}: {exc}; at a torque: {retry}") from exc
+            raise ContactFailure(f"coning: slice k={self.push:.4f}: {exc}") from exc
+        if not ok:
+            raise ContactFailure(f"coning: slice k={self.push:.4f} at {theta / ARCMIN:.4g} arcmin: "
+                                 f"tooth gaps {err * 1000:.3f} um off their linearisation after "
+                                 f"{GEO_MAX_IT} re-linearisations")
         self.active[side] = level.active
         self.levels += 1
         self.state_iterations += at.iterations - self.model.iterations
         self.torques[theta] = level.torque
         return at, level
-
-    def _settled(self, at: LostMotionModel, level, load):
-        level, err, ok = settle(at, level, load, GEO_TOL)
-        if not ok:
-            raise ContactFailure(f"tooth gaps {err * 1000:.3f} um off their linearisation after "
-                                 f"{GEO_MAX_IT} re-linearisations")
-        return level
-
-    def _at_twist(self, theta: float, side: int):
-        """The state at a prescribed twist, reached from the mount's zero twist in up to two
-        halvings if the active set cycles."""
-        at = self.model.fork()
-        level = at.solve_level_stepped(Twist(theta), self.active[side], Twist(0.0))
-        return at, self._settled(at, level, Twist(theta))
-
-    def _at_torque(self, theta: float, side: int):
-        """The state at ``theta`` found by torque control: the secant on the torque until the
-        settled state's twist is ``theta`` within a tenth of ``THETA_TOL``."""
-        near = sorted(self.torques.items(), key=lambda kv: abs(kv[0] - theta))
-        points = [(th, t) for th, t in near if th * side > 0][:2]
-        if len(points) < 2:    # no slope known on this side: from a small torque and a tenth of the test's
-            t_test = self.model.geometry.torque
-            points = []
-            for T in (side * 1e-3 * t_test, side * 0.1 * t_test):
-                at = self.model.fork()
-                level = self._settled(at, at.solve_level_stepped(T, self.active[side], 0.0), T)
-                points.append((level.twist, T))
-        (th_a, t_a), (th_b, t_b) = points[0], points[1]
-        iterations = 0
-        while True:
-            T = t_b + (theta - th_b) * (t_b - t_a) / (th_b - th_a)
-            at = self.model.fork()
-            level = self._settled(at, at.solve_level_stepped(T, self.active[side], t_b), T)
-            iterations += 1
-            if abs(level.twist - theta) < 0.1 * THETA_TOL:
-                return at, level
-            if iterations == MAX_EVALUATIONS:
-                raise ContactFailure(f"twist {theta / ARCMIN:.4g} arcmin not reached in {iterations} torques")
-            (th_a, t_a), (th_b, t_b) = (th_b, t_b), (level.twist, T)
 
 
 def build_slice(base: LostMotionModel, push: float) -> Slice:
@@ -272,7 +240,7 @@ def solve_coned(geom: DriveGeometry, mesh: DriveMesh, cases: list[tuple[float, i
         One per case; a failed slice fails every case that uses it (status "failed", no number).
     """
     try:
-        base = LostMotionModel(geom, mesh, zone_deg=zone_deg, changes=changes)
+        base = LostMotionModel(geom, mesh, zone_deg=zone_deg, changes=changes, max_iter=SLICE_MAX_ITER)
     except Exception as exc:   # any failure is reported, never a silent number
         return [ConedResult(math.nan, math.nan, math.nan, "failed", f"{type(exc).__name__}: {exc}",
                             (), 0, 0) for _ in cases]
@@ -321,7 +289,7 @@ def coned_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int,
         if changes.coning_slices < 1:
             raise ValueError(f"coning_slices must be at least 1, not {changes.coning_slices}")
         section = replace(changes, coning_slope=0.0, coning_slices=1)
-        base = LostMotionModel(geom, mesh, changes=section,
+        base = LostMotionModel(geom, mesh, changes=section, max_iter=SLICE_MAX_ITER,
                                zone_deg=PRELOAD_ZONE_DEG if zone_deg is None else zone_deg)
         slices = [build_slice(base, float(k))
                   for k in slice_pushes(changes.coning_slope, changes.coning_slices)]

@@ -67,16 +67,14 @@ def gap_only(old: Rows, new: Rows, u: np.ndarray) -> Rows:
 
 
 def settle(model: LostMotionModel, level: LevelSolution, torque: float | Twist, tol: float,
-           hold: float = 0.0, from_load: float | Twist | None = None) -> tuple[LevelSolution, float, bool]:
+           hold: float = 0.0) -> tuple[LevelSolution, float, bool]:
     """Re-solve ``level`` (the solution of the model's current rows at ``torque``, N mm)
     with the tooth and cam rows re-detected at the solution until they equal their
     linearisations within ``tol`` (mm).
 
     The tooth rows keep their slave nodes, so a pair keeps its identity (and its cached
     compliance column while its row is unchanged); ``hold`` (mm) is added to every
-    re-detected tooth gap (the preload ramp's overlap not yet ramped in).  With ``from_load`` a
-    re-solve whose active set cycles is reached from that load in halvings
-    (``LostMotionModel.solve_level_stepped``).
+    re-detected tooth gap (the preload ramp's overlap not yet ramped in).
 
     Returns
     -------
@@ -100,8 +98,7 @@ def settle(model: LostMotionModel, level: LevelSolution, torque: float | Twist, 
             model.rows["tooth"] = gap_only(model.rows["tooth"], tooth, u)
             model.rows["cam"] = gap_only(model.rows["cam"], cam, u)
         prev = err
-        level = (model.solve_level(torque, level.active) if from_load is None
-                 else model.solve_level_stepped(torque, level.active, from_load))
+        level = model.solve_level(torque, level.active)
         tooth, cam, err = _redetect(model, level.u_watch, hold)
     return level, err, err < tol
 
