@@ -369,14 +369,12 @@ def solve_lost_motion_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_r
     for ch in variants:
         _check_geometry(geom, ch)
     if any(ch.coning_slope != 0.0 for ch in variants):
-        # the coned cup mounts its own slices: solved apart, once per contact model
-        coned = {ch.fe_part(): _coned(geom, mesh, steps_per_ramp, ch.fe_part())
-                 for ch in variants if ch.coning_slope != 0.0}
+        # the coned cup mounts its own slices: solved apart, once per distinct variant
+        coned = {ch: _coned(geom, mesh, steps_per_ramp, ch) for ch in variants if ch.coning_slope != 0.0}
         rest = [ch for ch in variants if ch.coning_slope == 0.0]
         solved = dict(zip(rest, solve_lost_motion_variants(geom, mesh, steps_per_ramp, rest, shared)
                           if rest else []))
-        return [solved[ch] if ch.coning_slope == 0.0 else _with_series(coned[ch.fe_part()], ch)
-                for ch in variants]
+        return [coned.get(ch) or solved[ch] for ch in variants]
     if geom.preloaded:
         return _preloaded_variants(geom, mesh, steps_per_ramp, variants, shared)
     t0 = time.perf_counter()
@@ -409,17 +407,6 @@ def _coned(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int, changes: M
     # imported here: hdwf.fe.coning builds on this module's mount and test
     from hdwf.fe.coning import coned_lost_motion
     return coned_lost_motion(geom, mesh, steps_per_ramp, changes, zone_deg, keep_fields)
-
-
-def _with_series(res: LostMotionResult, changes: ModelChanges) -> LostMotionResult:
-    """A result of the contact model ``changes.fe_part()`` with ``changes``' series elements."""
-    if res.status != "ok" or changes == changes.fe_part():
-        return res
-    tw = series_output_twist(res.twist_arcmin * ARCMIN, res.torque_Nm * 1000.0, changes) / ARCMIN
-    tw = tw - tw[0]
-    kp, km = int(np.argmax(res.torque_Nm)), int(np.argmin(res.torque_Nm))
-    return replace(res, twist_arcmin=tw, phi_plus_arcmin=float(tw[kp]), phi_minus_arcmin=float(-tw[km]),
-                   lost_motion_arcmin=float(tw[kp] - tw[km]))
 
 
 def _preloaded_variants(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int,
