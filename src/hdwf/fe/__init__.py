@@ -12,6 +12,8 @@ Phi = phi + phi'.  The modules, from the bottom up:
 * ``structure``: the bodies seen through the watch vector, the torque load and twist measure;
 * ``contact_geometry`` and ``contact_rows``: closest points and normals on the contact
   surfaces, and the linearised gaps of cam, balls, fit and teeth;
+* ``flank_layer``: a compliant layer between the flanks, each tooth pair's compliance from its
+  share of the overlap integrated along the slave outline;
 * ``column_store``, ``node_columns``, ``working_set`` and ``friction``: compliance columns kept
   in chunks a fork shares, the responses kept per tooth node, the cached compliance of the
   working set, and the flank law (frictionless or Coulomb) with its own cache and stick/slip state;

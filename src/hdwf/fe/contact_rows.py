@@ -22,7 +22,10 @@ Contacts (unilateral; the flanks may carry friction, ``friction``), one block of
   went with the node spacing and moved Phi of hd42-lhs-22 by 2.5 % between meshes),
   built at the wave-generator-deflected configuration (gaps evaluated at the deformed FS)
   and linearised about it (small deformation on top of the deflected state).  Every tooth
-  pair also has a slip row (tangent to the master segment) for flank friction.
+  pair also has a slip row (tangent to the master segment) for flank friction.  With a
+  flank layer every pair has a compliance in series: its node's share of the layer's
+  pressure (overlap / c) integrated along the slave outline (``LayerEdges``; the share
+  depends on the gaps, so the solver iterates it as it does the balls' Hertz secants).
 
 Half model: contacts cover angles [0, pi) only, each standing for itself and its image:
 balls 0 .. n/2-1 (ball 0 on the cut), fit bins over [0, pi), cam rows and tooth slave nodes
@@ -43,6 +46,7 @@ from hdwf.drive.cam import cam_points
 from hdwf.drive.geometry import DriveGeometry
 from hdwf.fe.bodies import Body
 from hdwf.fe.contact_geometry import boundary_edge_normals, closest_on_cam, closest_segments
+from hdwf.fe.flank_layer import LayerEdges, layer_edges
 from hdwf.fe.structure import Structure
 
 BALL_PATCH_FRAC = 0.125  # ball load spread over +-ball_dia/8 of raceway arc
@@ -65,6 +69,7 @@ class Rows:
     tooth: np.ndarray | None = None           # FS tooth id of every pair
     slave_nodes: tuple[np.ndarray, np.ndarray] | None = None   # (FS nodes, CS nodes)
     compliance: np.ndarray | None = None      # (n,) mm/N of a layer in series with each pair
+    layer: LayerEdges | None = None           # the slave edges the layer's overlap is integrated on
 
 
 @dataclass(frozen=True)
@@ -377,11 +382,15 @@ def tooth_rows(structure: Structure, geom: DriveGeometry, u_watch: np.ndarray, c
     fs_pass = _node_to_segment(fs, sn_fs, cs, "cs_teeth", u_watch, cand_gap)
     cs_pass = _node_to_segment(cs, sn_cs, fs, "fs_teeth", u_watch, cand_gap)
     sn_fs, sn_cs = sn_fs[fs_pass.kept], sn_cs[cs_pass.kept]
-    compliance = None
+    compliance = layer = None
     if geom.flank_layer_um_per_MPa > 0:
-        compliance = 1e-3 * geom.flank_layer_um_per_MPa / np.concatenate(
+        c = 1e-3 * geom.flank_layer_um_per_MPa
+        compliance = c / np.concatenate(
             [geom.face_fs * _tributary_length(fs, "fs_teeth", sn_fs),
              geom.face_cs * _tributary_length(cs, "cs_teeth", sn_cs)])
+        layer = layer_edges(
+            [(fs, sn_fs, cs, "fs_teeth", "cs_teeth", c / geom.face_fs, 0),
+             (cs, sn_cs, fs, "cs_teeth", "fs_teeth", c / geom.face_cs, sn_fs.size)], u_watch)
     # which FS tooth a pair belongs to (teeth in contact); the half model's tooth z/2
     # is the image of tooth 0 (ids modulo z/2; counted twice)
     zid = geom.z_fs // 2 if structure.half else geom.z_fs
@@ -391,7 +400,7 @@ def tooth_rows(structure: Structure, geom: DriveGeometry, u_watch: np.ndarray, c
     return Rows("tooth", sp.vstack([fs_pass.G, cs_pass.G]).tocsr(),
                 np.concatenate([fs_pass.g0, cs_pass.g0]),
                 slip=sp.vstack([fs_pass.slip, cs_pass.slip]).tocsr(), tooth=tooth,
-                slave_nodes=(sn_fs, sn_cs), compliance=compliance)
+                slave_nodes=(sn_fs, sn_cs), compliance=compliance, layer=layer)
 
 
 def _tributary_length(body: Body, edge_set: str, nodes: np.ndarray) -> np.ndarray:

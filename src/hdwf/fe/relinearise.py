@@ -122,12 +122,15 @@ def layer_approach(model: LostMotionModel, level: LevelSolution, check: Rows) ->
     if rows.compliance is None:
         return np.zeros(check.G.shape[0])
     force = np.zeros(rows.G.shape[0])
-    for (kind, i), p in zip(level.pair_ids, level.normal_force):
+    compliance = rows.compliance.copy()
+    for j, ((kind, i), p) in enumerate(zip(level.pair_ids, level.normal_force)):
         if kind == "tooth":
             force[i] = p
+            if level.row_compliance is not None:
+                compliance[i] = level.row_compliance[j]
     fs_nodes, cs_nodes = rows.slave_nodes
-    key = {("fs", n): a for n, a in zip(fs_nodes.tolist(), (rows.compliance * force)[:fs_nodes.size])}
-    key.update({("cs", n): a for n, a in zip(cs_nodes.tolist(), (rows.compliance * force)[fs_nodes.size:])})
+    key = {("fs", n): a for n, a in zip(fs_nodes.tolist(), (compliance * force)[:fs_nodes.size])}
+    key.update({("cs", n): a for n, a in zip(cs_nodes.tolist(), (compliance * force)[fs_nodes.size:])})
     cf, cc = check.slave_nodes
     return np.array([key.get(("fs", n), 0.0) for n in cf.tolist()] + [key.get(("cs", n), 0.0) for n in cc.tolist()])
 

@@ -23,7 +23,9 @@ pair that was open at the current point penetrated by more than ``max_overshoot`
 taken: as in a primal active-set method the step stops where the first open pair closes
 (ratio test), that pair enters the active set and nothing is dropped.
 Around the PDAS, the Hertz secants s_ball of the balls are iterated to 0.1 % of the ball
-loads, and with flank friction the stick/slip states of the tooth pairs (``friction``).
+loads, with a flank layer its compliance at every tooth pair (the pair's share of the
+overlap integral depends on its neighbours' gaps) until no approach s p moves by more than the
+gap tolerance, and with flank friction the stick/slip states of the tooth pairs (``friction``).
 A level is solved at a torque (load control) or at a prescribed rim twist (``Twist``,
 displacement control): the torque is then one more unknown, T u_T its displacement (u_T the
 unit-torque response), with the equation q^T u = theta; scaled by the rim's load factor that
@@ -43,6 +45,7 @@ from scipy.linalg import cho_factor, cho_solve
 
 from hdwf.drive.geometry import ARCMIN
 from hdwf.fe.contact_rows import PairId, Rows, stack_rows
+from hdwf.fe.flank_layer import LayerIteration
 from hdwf.fe.friction import (FRICTION_MAX_IT, ActiveBlock, FlankLaw, FrictionLevel, NoFriction,
                               FrictionlessLevel)
 from hdwf.fe.structure import ModeName, RigidModes, Structure
@@ -100,6 +103,7 @@ class LevelSolution:
     twist: float                  # rim twist q^T u (rad)
     active: frozenset[PairId]     # pairs in contact (warm start of the next level)
     torque: float = float("nan")  # torque on the rim (N mm): given, or solved for at a ``Twist``
+    row_compliance: np.ndarray | None = None   # the layer's compliance of every pair at this level
 
 
 @dataclass(frozen=True)
@@ -119,6 +123,7 @@ class _LevelProblem:
     mode_target: np.ndarray       # right-hand side of the mode rows beyond -T R^T f
     ball_index: np.ndarray        # positions of the ball pairs in ``ids``
     row_compliance: np.ndarray    # constant compliance in series with each pair (flank layer)
+    tooth_index: np.ndarray       # positions of the tooth pairs in ``ids`` (row order)
     u_start: np.ndarray           # last level's displacement (or the free torque response)
     free_gap: np.ndarray          # g0 + G u_start
     projected: ProjectedColumns   # G K^-1 G_W^T, the gaps of a frictionless iterate
@@ -153,6 +158,8 @@ class ContactSolver:
     last_u: np.ndarray | None = None
     ball_loads: np.ndarray | None = None
     projected: ProjectedColumns | None = None   # of the last level, kept while its rows stay
+    layer_state: tuple | None = None            # (tooth layer edges, their compliances) of the last level
+    row_compliance: np.ndarray | None = None    # of the last level's pairs
 
     def copy(self) -> "ContactSolver":
         """An independent copy of the state (working set and friction cache copied)."""
@@ -227,6 +234,7 @@ class ContactSolver:
             mode_gap_rates=G @ rigid.watch, mode_block=block, mode_target=target,
             ball_index=np.array([j for j, (k, _) in enumerate(ids) if k == "ball"]),
             row_compliance=stacked.compliance,
+            tooth_index=np.array([j for j, (k, _) in enumerate(ids) if k == "tooth"], dtype=np.int64),
             u_start=u0, free_gap=g0 + G @ u0, projected=self.projected, label=describe(load),
             torque_unknown=isinstance(load, Twist))
 
@@ -270,31 +278,46 @@ class ContactSolver:
         twist = level.add_slip_twist(twist, wp, fw)
         torque = float(outcome.alpha[-1]) if problem.torque_unknown else problem.torque
         return LevelSolution(p_full, ft, outcome.alpha, outcome.u, outcome.gap, ids, float(twist),
-                             frozenset(act), torque)
+                             frozenset(act), torque, self.row_compliance)
 
     def _hertz_loop(self, problem: _LevelProblem, act: set[PairId],
                     level: Level) -> tuple[_ActiveSetOutcome, set[PairId]]:
-        """PDAS solves with the Hertz secants of the balls updated to convergence."""
+        """PDAS solves with the Hertz secants of the balls and the flank layer's compliances
+        (``LayerEdges``: each pair's share of the overlap integral) updated to convergence."""
         pb = self.ball_loads
         if pb is None:
             pb = np.full(problem.ball_index.size, 1.0)
+        layer = problem.rows["tooth"].layer if "tooth" in problem.rows else None
+        s_rows = problem.row_compliance.copy()
+        ti = problem.tooth_index
+        if layer is not None and self.layer_state is not None and self.layer_state[0] is layer:
+            s_rows[ti] = self.layer_state[1]
+        shares = LayerIteration(layer, ti) if layer is not None else None
         for _ in range(40):
             s_ball = self.ball_compliance * np.maximum(pb, 1e-3) ** (-1.0 / 3.0)
-            outcome = self._pdas(problem, act, s_ball, level)
+            outcome = self._pdas(problem, act, s_ball, level, s_rows)
             act = {problem.ids[j] for j in np.flatnonzero(outcome.p > 0)}
             pb_new = outcome.p[problem.ball_index]
             on = pb_new > 0        # the secant of an open ball does not matter
             change = (np.max(np.abs(pb_new - pb)[on]) if on.any() else 0.0) / max(
                 1e-9, np.max(np.abs(pb_new)))
             pb = np.where(pb_new > 0, pb_new, pb)
+            layer_residual, s_solved = 0.0, s_rows
+            if shares is not None:
+                s_rows, layer_residual = shares.step(outcome.p, outcome.gap, s_rows)
             if not outcome.converged:
                 raise ContactFailure(f"active-set iteration did not converge in "
                                      f"{self.settings.max_iter} iterations at {problem.label}")
-            if change < 1e-3:
+            if change < 1e-3 and layer_residual < self.settings.tol_gap:
                 break
         else:
-            raise ContactFailure("Hertz secant iteration on ball loads did not converge")
+            raise ContactFailure("Hertz secant iteration on ball loads (and flank-layer shares) "
+                                 "did not converge")
         self.ball_loads = pb
+        if layer is not None:     # the updated shares warm-start the next level
+            self.layer_state = (layer, s_rows[ti].copy())
+            s_rows = s_solved
+        self.row_compliance = s_rows   # what the outcome was solved with
         if outcome.u is None:
             outcome = replace(outcome, u=self._displacement(problem, outcome.positions, outcome.p_active,
                                                             outcome.alpha))
@@ -302,10 +325,10 @@ class ContactSolver:
 
     # ---------------------------------------------------------------- PDAS
     def _pdas(self, problem: _LevelProblem, act: set[PairId], s_ball: np.ndarray,
-              level: Level) -> _ActiveSetOutcome:
+              level: Level, row_compliance: np.ndarray) -> _ActiveSetOutcome:
         """Primal-dual active set on the dense dual problem; see the module docstring."""
         ids = problem.ids
-        sdiag = problem.row_compliance.copy()
+        sdiag = row_compliance.copy()
         sdiag[problem.ball_index] = s_ball
         Guq = problem.G @ problem.structure.unit_torque_u_watch
         A = set(act)
@@ -463,3 +486,4 @@ def _same_rows(A: sp.csr_matrix, B: sp.csr_matrix) -> bool:
     """Whether two stacked row operators are the same numbers (so are their projections)."""
     return (A.shape == B.shape and A.nnz == B.nnz and np.array_equal(A.indptr, B.indptr)
             and np.array_equal(A.indices, B.indices) and np.array_equal(A.data, B.data))
+
