@@ -121,7 +121,7 @@ if __name__ == "__main__":
                     help="explicit c:N pairs, e.g. 0:1,0.4:4 (instead of --coning x --slices)")
     ap.add_argument("--tip-relief", type=float, default=1.1)
     ap.add_argument("--flank-layer", type=float, default=0.0,
-                    help="flank layer thickness in units of m (the studies' model: 4200)")
+                    help="flank layer thickness in units of m (the studies' model: 3900)")
     ap.add_argument("--mesh", default="5x3", help="elements over tooth height x thickness")
     ap.add_argument("--out", type=Path, default=Path("coning.csv"))
     ap.add_argument("--summary-only", action="store_true")
