@@ -8,8 +8,14 @@ corner (its offset along the segment's normal is the gap to the segment's straig
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
 import numpy as np
 from scipy.spatial import cKDTree
+
+if TYPE_CHECKING:
+    from hdwf.fe.bodies import Body
 
 
 def closest_on_cam(cp: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -143,3 +149,27 @@ def closest_segments(xs: np.ndarray, xa: np.ndarray, xb: np.ndarray, nrm: np.nda
     # internal gear's flanks are concave polylines): a penetration of that distance
     inside = (bg > 0) & (front < 0)
     return np.where(inside, -bg, bg), be, bt
+
+
+@dataclass(frozen=True)
+class OutlineMatch:
+    """Nodes matched to the closest segment of another body's deformed outline."""
+    gap: np.ndarray          # (n,) signed gap (mm; negative: penetration)
+    segment: np.ndarray      # (n,) index into ``edges``
+    t: np.ndarray            # (n,) parameter of the closest point on it
+    edges: np.ndarray        # (m, 2) the watched outline edges (node ids of the master body)
+    normals: np.ndarray      # (2, m) their outward unit normals
+
+
+def match_to_outline(sb: "Body", nodes: np.ndarray, mb: "Body", edge_set: str,
+                     u_watch: np.ndarray) -> OutlineMatch:
+    """``nodes`` of body ``sb`` against the watched ``edge_set`` segments of body ``mb``, both
+    at the displacement ``u_watch`` (``closest_segments``)."""
+    xs = sb.x[:, nodes] + sb.node_displacements(nodes, u_watch)
+    E = mb.body_mesh.edge_sets[edge_set]
+    E = E[(mb.watch_index[0, E[:, 0]] >= 0) & (mb.watch_index[0, E[:, 1]] >= 0)]
+    nrm = boundary_edge_normals(mb.body_mesh.mesh, E)
+    xa = mb.x[:, E[:, 0]] + mb.node_displacements(E[:, 0], u_watch)
+    xb = mb.x[:, E[:, 1]] + mb.node_displacements(E[:, 1], u_watch)
+    gap, seg, t = closest_segments(xs, xa, xb, nrm)
+    return OutlineMatch(gap, seg, t, E, nrm)

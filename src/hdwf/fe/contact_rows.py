@@ -45,7 +45,7 @@ import scipy.sparse as sp
 from hdwf.drive.cam import cam_points
 from hdwf.drive.geometry import DriveGeometry
 from hdwf.fe.bodies import Body
-from hdwf.fe.contact_geometry import boundary_edge_normals, closest_on_cam, closest_segments
+from hdwf.fe.contact_geometry import closest_on_cam, match_to_outline
 from hdwf.fe.flank_layer import LayerEdges, layer_edges
 from hdwf.fe.structure import Structure
 
@@ -313,13 +313,8 @@ def _node_to_segment(sb: Body, sn: np.ndarray, mb: Body, edge_set: str,
     configuration: normal and tangential (slip) rows d . (u_slave - u_master point) and the
     gap g0 + G u of the pairs whose gap is below ``cand_gap``."""
     nwatch = u_watch.size
-    xs = sb.x[:, sn] + sb.node_displacements(sn, u_watch)
-    E = mb.body_mesh.edge_sets[edge_set]
-    E = E[(mb.watch_index[0, E[:, 0]] >= 0) & (mb.watch_index[0, E[:, 1]] >= 0)]
-    nrm = boundary_edge_normals(mb.body_mesh.mesh, E)
-    xa = mb.x[:, E[:, 0]] + mb.node_displacements(E[:, 0], u_watch)
-    xb = mb.x[:, E[:, 1]] + mb.node_displacements(E[:, 1], u_watch)
-    bg, be, bt = closest_segments(xs, xa, xb, nrm)
+    match = match_to_outline(sb, sn, mb, edge_set, u_watch)
+    bg, be, bt, E, nrm = match.gap, match.segment, match.t, match.edges, match.normals
     kept = bg < cand_gap
     sn, bg, be, bt = sn[kept], bg[kept], be[kept], bt[kept]
     n = nrm[:, be]

@@ -14,8 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hdwf.fe.bodies import Body
-from hdwf.fe.contact_geometry import boundary_edge_normals, closest_segments
+from hdwf.fe.contact_geometry import match_to_outline
 
 
 @dataclass(frozen=True)
@@ -72,23 +71,11 @@ def layer_edges(passes, u_watch: np.ndarray) -> LayerEdges:
         gap_of = np.full(sb.x.shape[1], -np.inf)    # not watched: the end counts as overlapping
         others = others[sb.watch_index[0, others] >= 0]
         if others.size:
-            gap_of[others] = _node_gaps(sb, others, mb, master_set, u_watch)
+            gap_of[others] = match_to_outline(sb, others, mb, master_set, u_watch).gap
         length = np.hypot(*(sb.x[:, E[:, 1]] - sb.x[:, E[:, 0]]))
         parts.append((ra, rb, 0.5 * length, gap_of[E[:, 0]], gap_of[E[:, 1]],
                       np.full(sn.size, per_length)))
     return LayerEdges(*(np.concatenate(x) for x in zip(*parts)))
-
-
-def _node_gaps(sb: Body, nodes: np.ndarray, mb: Body, edge_set: str, u_watch: np.ndarray) -> np.ndarray:
-    """Gap (mm) of ``nodes`` of ``sb`` to the closest ``edge_set`` segment of ``mb`` at ``u_watch``."""
-    xs = sb.x[:, nodes] + sb.node_displacements(nodes, u_watch)
-    E = mb.body_mesh.edge_sets[edge_set]
-    E = E[(mb.watch_index[0, E[:, 0]] >= 0) & (mb.watch_index[0, E[:, 1]] >= 0)]
-    nrm = boundary_edge_normals(mb.body_mesh.mesh, E)
-    xa = mb.x[:, E[:, 0]] + mb.node_displacements(E[:, 0], u_watch)
-    xb = mb.x[:, E[:, 1]] + mb.node_displacements(E[:, 1], u_watch)
-    return closest_segments(xs, xa, xb, nrm)[0]
-
 
 
 @dataclass
