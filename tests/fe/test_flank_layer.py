@@ -27,14 +27,14 @@ def test_force_of_a_linear_overlap_is_its_area_on_any_nodes(seed):
     layer = _line(x)
     force = np.maximum(-gap, 0.0) / layer.compliance(gap)
     assert force.sum() == pytest.approx(0.5 * k * x0 ** 2, rel=1e-12)
-    full = _line(x).per_length / layer.compliance(np.full(x.size, -1.0))  # every node overlapping
+    full = layer.per_length / layer.compliance(np.full(x.size, -1.0))  # every node overlapping
     lumped = (np.maximum(-gap, 0.0) * full).sum()
     assert abs(lumped / (0.5 * k * x0 ** 2) - 1) > 0.01
 
 
 def test_a_uniform_overlap_keeps_each_node_half_its_edges():
     """Where both ends of every edge overlap, a node's share is half of each of its edges (the
-    trapezoid rule, exact for a linear overlap): the layer as lumped before, unchanged."""
+    trapezoid rule, exact for a linear overlap): the same shares as the lumped rule."""
     x = np.array([0.0, 0.1, 0.25, 0.3, 0.5])
     layer = _line(x)
     share = 1.0 / layer.compliance(np.full(x.size, -2e-3))

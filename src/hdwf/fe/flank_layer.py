@@ -4,7 +4,7 @@ A layer of compliance c per unit area (``ModelChanges.flank_layer_m``) between t
 presses with overlap / c; a tooth pair (a slave node) carries its node's share of that
 pressure integrated along the slave outline, so its compliance is c / (b L) with b the face
 width and L that share.  L depends on the gaps (where a contact ends inside an edge), so the
-solver iterates it (``layer_update``), as it does the balls' Hertz secants.  Hand-written: no
+solver iterates it (``LayerIteration``), as it does the balls' Hertz secants.  Hand-written: no
 library integrates a penalty layer over a node-to-segment contact of this kind.
 """
 

@@ -45,7 +45,7 @@ from scipy.linalg import cho_factor, cho_solve
 
 from hdwf.drive.geometry import ARCMIN
 from hdwf.fe.contact_rows import PairId, Rows, stack_rows
-from hdwf.fe.flank_layer import LayerIteration
+from hdwf.fe.flank_layer import LayerEdges, LayerIteration
 from hdwf.fe.friction import (FRICTION_MAX_IT, ActiveBlock, FlankLaw, FrictionLevel, NoFriction,
                               FrictionlessLevel)
 from hdwf.fe.structure import ModeName, RigidModes, Structure
@@ -141,6 +141,7 @@ class _ActiveSetOutcome:
     converged: bool
     positions: np.ndarray         # working-set positions of the active pairs ...
     p_active: np.ndarray          # ... and their forces (what u is formed from)
+    row_compliance: np.ndarray | None = None   # the compliance in series with each pair it was solved with
 
 
 @dataclass
@@ -158,8 +159,7 @@ class ContactSolver:
     last_u: np.ndarray | None = None
     ball_loads: np.ndarray | None = None
     projected: ProjectedColumns | None = None   # of the last level, kept while its rows stay
-    layer_state: tuple | None = None            # (tooth layer edges, their compliances) of the last level
-    row_compliance: np.ndarray | None = None    # of the last level's pairs
+    layer_state: tuple[LayerEdges, np.ndarray] | None = None   # the last level's tooth layer and its compliances
 
     def copy(self) -> "ContactSolver":
         """An independent copy of the state (working set and friction cache copied)."""
@@ -278,7 +278,7 @@ class ContactSolver:
         twist = level.add_slip_twist(twist, wp, fw)
         torque = float(outcome.alpha[-1]) if problem.torque_unknown else problem.torque
         return LevelSolution(p_full, ft, outcome.alpha, outcome.u, outcome.gap, ids, float(twist),
-                             frozenset(act), torque, self.row_compliance)
+                             frozenset(act), torque, outcome.row_compliance)
 
     def _hertz_loop(self, problem: _LevelProblem, act: set[PairId],
                     level: Level) -> tuple[_ActiveSetOutcome, set[PairId]]:
@@ -317,7 +317,7 @@ class ContactSolver:
         if layer is not None:     # the updated shares warm-start the next level
             self.layer_state = (layer, s_rows[ti].copy())
             s_rows = s_solved
-        self.row_compliance = s_rows   # what the outcome was solved with
+        outcome = replace(outcome, row_compliance=s_rows)   # what it was solved with
         if outcome.u is None:
             outcome = replace(outcome, u=self._displacement(problem, outcome.positions, outcome.p_active,
                                                             outcome.alpha))
@@ -486,4 +486,3 @@ def _same_rows(A: sp.csr_matrix, B: sp.csr_matrix) -> bool:
     """Whether two stacked row operators are the same numbers (so are their projections)."""
     return (A.shape == B.shape and A.nnz == B.nnz and np.array_equal(A.indptr, B.indptr)
             and np.array_equal(A.indices, B.indices) and np.array_equal(A.data, B.data))
-
