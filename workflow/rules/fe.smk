@@ -31,6 +31,9 @@ rule fe_solve:
         steps_per_ramp=FE["steps_per_ramp"],
         effects=FE["effects"],
     threads: 1
+    # before the convergence runs (priority 0): the statistics wait for these, the report alone
+    # for those, so the stages after the solves run while the convergence runs fill the cores
+    priority: 1
     resources:
         mem_mb=4000,
         runtime=30,
@@ -56,6 +59,7 @@ rule fe_aggregate:
     params:
         effects=FE["effects"],
         calibrated_on=FE.get("calibrated_on"),
+    priority: 2
     benchmark:
         "results/benchmarks/{study}_{unit}_aggregate.tsv"
     log:

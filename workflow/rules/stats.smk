@@ -7,6 +7,7 @@ rule correlation:
         table="results/{study}/{unit}/correlation.parquet",
         figure=report("results/{study}/{unit}/correlation.png", caption="../report/correlation.rst",
                       category="{study}", subcategory="{unit}"),
+    priority: 2
     benchmark:
         "results/benchmarks/{study}_{unit}_correlation.tsv"
     log:
@@ -25,6 +26,7 @@ rule surrogate:
                       category="{study}", subcategory="{unit}"),
     params:
         bounds_source=lambda w: STUDIES[w.study]["surrogate_bounds"],
+    priority: 2
     benchmark:
         "results/benchmarks/{study}_{unit}_surrogate.tsv"
     log:
@@ -44,6 +46,7 @@ rule sobol:
     params:
         settings={k: v for k, v in config["sobol"].items() if k != "samplers"},
         samplers=config["sobol"]["samplers"],
+    priority: 2
     benchmark:
         "results/benchmarks/{study}_{unit}_sobol.tsv"
     log:

@@ -15,6 +15,7 @@ rule validation_specimen:
         steps_per_ramp=lambda w: CAMPAIGNS[w.campaign].steps_per_ramp,
         variants=lambda w: CAMPAIGNS[w.campaign].table_variants(),
     threads: 1
+    priority: 1
     resources:
         mem_mb=4000,
         runtime=60,
@@ -36,8 +37,11 @@ rule validation_diagnosis:
         points="results/validation/{campaign}/points.parquet",
     params:
         plan=plan_dict,
-    # an effect found before the next round is re-solved near its estimate, every specimen
-    threads: 2
+    # an effect found before the next round is re-solved near its estimate, every specimen.
+    # One core and a priority: a two-core job waits until both cores are free at once, which
+    # a queue of one-core solves never leaves, so it ran last and alone; now it runs beside them
+    threads: 1
+    priority: 2
     resources:
         mem_mb=8000,
     benchmark:
@@ -50,7 +54,7 @@ rule validation_diagnosis:
 
 rule validation_ladder:
     # one job per campaign (a rung needs one or two solves per specimen, fewer seconds than
-    # a job per specimen spends starting up), its specimens in 2 processes
+    # a job per specimen spends starting up); one core, as the diagnosis
     input:
         measurements=lambda w: CAMPAIGNS[w.campaign].measurements,
         diagnosis="results/validation/{campaign}/diagnosis.json",
@@ -62,7 +66,8 @@ rule validation_ladder:
         unit=lambda w: CAMPAIGNS[w.campaign].unit,
         settings=lambda w: CAMPAIGNS[w.campaign].settings,
         steps_per_ramp=lambda w: CAMPAIGNS[w.campaign].steps_per_ramp,
-    threads: 2
+    threads: 1
+    priority: 2
     resources:
         mem_mb=4000,
     benchmark:
@@ -85,6 +90,7 @@ rule validation_figures:
                          category="validation", subcategory="{campaign}"),
         ladder=report("results/validation/{campaign}/ladder.png", caption="../report/validation.rst",
                       category="validation", subcategory="{campaign}"),
+    priority: 2
     benchmark:
         "results/benchmarks/validation_{campaign}_figures.tsv"
     log:
