@@ -46,7 +46,7 @@ from hdwf.drive.cam import cam_points
 from hdwf.drive.geometry import DriveGeometry
 from hdwf.fe.bodies import Body
 from hdwf.fe.contact_geometry import closest_on_cam, match_to_outline
-from hdwf.fe.flank_layer import LayerEdges, layer_edges
+from hdwf.fe.flank_layer import LayerEdges, LayerPass, layer_edges
 from hdwf.fe.structure import Structure
 
 BALL_PATCH_FRAC = 0.125  # ball load spread over +-ball_dia/8 of raceway arc
@@ -384,8 +384,8 @@ def tooth_rows(structure: Structure, geom: DriveGeometry, u_watch: np.ndarray, c
             [geom.face_fs * _tributary_length(fs, "fs_teeth", sn_fs),
              geom.face_cs * _tributary_length(cs, "cs_teeth", sn_cs)])
         layer = layer_edges(
-            [(fs, sn_fs, cs, "fs_teeth", "cs_teeth", c / geom.face_fs, 0),
-             (cs, sn_cs, fs, "cs_teeth", "fs_teeth", c / geom.face_cs, sn_fs.size)], u_watch)
+            [LayerPass(fs, sn_fs, "fs_teeth", cs, "cs_teeth", c / geom.face_fs, first_row=0),
+             LayerPass(cs, sn_cs, "cs_teeth", fs, "fs_teeth", c / geom.face_cs, first_row=sn_fs.size)], u_watch)
     # which FS tooth a pair belongs to (teeth in contact); the half model's tooth z/2
     # is the image of tooth 0 (ids modulo z/2; counted twice)
     zid = geom.z_fs // 2 if structure.half else geom.z_fs

@@ -10,11 +10,16 @@ library integrates a penalty layer over a node-to-segment contact of this kind.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from hdwf.fe.contact_geometry import match_to_outline
+
+if TYPE_CHECKING:
+    from hdwf.fe.bodies import Body
 
 
 @dataclass(frozen=True)
@@ -56,14 +61,30 @@ class LayerEdges:
         return self.per_length / np.maximum(share, 1e-3 * full)
 
 
-def layer_edges(passes, u_watch: np.ndarray) -> LayerEdges:
-    """``LayerEdges`` of the two passes: every slave edge with a row at one end at least; an
-    end that is no row gets its gap to the master outline at ``u_watch``."""
+@dataclass(frozen=True)
+class LayerPass:
+    """One contact pass as the layer sees it: the slave nodes of ``slave_set`` on ``slave``
+    are rows ``first_row``, ``first_row + 1``, ... of the stacked tooth rows, pressed against
+    ``master_set`` of ``master``; ``per_length`` is the layer's compliance over the slave's face
+    width (mm^2/N)."""
+    slave: Body
+    slave_nodes: np.ndarray
+    slave_set: str
+    master: Body
+    master_set: str
+    per_length: float
+    first_row: int
+
+
+def layer_edges(passes: Sequence[LayerPass], u_watch: np.ndarray) -> LayerEdges:
+    """``LayerEdges`` of the passes: every slave edge with a row at one end at least; an end
+    that is no row gets its gap to the master outline at ``u_watch``."""
     parts = []
-    for sb, sn, mb, slave_set, master_set, per_length, offset in passes:
-        E = sb.body_mesh.edge_sets[slave_set]
+    for p in passes:
+        sb, sn = p.slave, p.slave_nodes
+        E = sb.body_mesh.edge_sets[p.slave_set]
         row_of = -np.ones(sb.x.shape[1], dtype=np.int64)
-        row_of[sn] = offset + np.arange(sn.size)
+        row_of[sn] = p.first_row + np.arange(sn.size)
         ra, rb = row_of[E[:, 0]], row_of[E[:, 1]]
         keep = (ra >= 0) | (rb >= 0)
         E, ra, rb = E[keep], ra[keep], rb[keep]
@@ -71,10 +92,10 @@ def layer_edges(passes, u_watch: np.ndarray) -> LayerEdges:
         gap_of = np.full(sb.x.shape[1], -np.inf)    # not watched: the end counts as overlapping
         others = others[sb.watch_index[0, others] >= 0]
         if others.size:
-            gap_of[others] = match_to_outline(sb, others, mb, master_set, u_watch).gap
+            gap_of[others] = match_to_outline(sb, others, p.master, p.master_set, u_watch).gap
         length = np.hypot(*(sb.x[:, E[:, 1]] - sb.x[:, E[:, 0]]))
         parts.append((ra, rb, 0.5 * length, gap_of[E[:, 0]], gap_of[E[:, 1]],
-                      np.full(sn.size, per_length)))
+                      np.full(sn.size, p.per_length)))
     return LayerEdges(*(np.concatenate(x) for x in zip(*parts)))
 
 
