@@ -2,13 +2,15 @@
 
 Solves one design (a study's ``designs.parquet`` row, or Table 3's nominal changed by ``--base``)
 at each ``--preload`` (interference_m; 0 is the bare section, relief 1.1 with a preload as the
-studies use it) on the default half mesh and prints, per preload: Φ, the summed normal force of
+studies use it; ``--flank-layer`` L adds the studies' flank layer of L modules) on the half mesh of
+``--refinement`` (default 1) and prints, per preload: Φ, the summed normal force of
 the tooth pairs, of the cam and of the balls at the mount (the half model's sums doubled: the
 whole drive), the most loaded ball and its raceway pressure against ISO 76's 4200 MPa, and the
 tangential force the test torque puts on the mesh, T / r_p. ``--bands`` adds the tooth normal
 force at the mount and at +T per 10° band from the nearer major axis, split into pairs whose
 slave node is an FS flank node and CS tip nodes (the second pass, a CS tip on an FS flank),
-over one half of the half model. ``--depth`` adds how deep in the CS spaces the loaded pairs
+over one half of the half model, and the change of the bands' moment on the FS from the mount
+to +T (where the test torque is carried). ``--depth`` adds how deep in the CS spaces the loaded pairs
 sit at +T: force and pair count per 0.1 m band (``band_m``) of the slave node's deformed radius
 minus the CS tip radius (0: on the CS tip's edge; the CS root is about 1.9 m deeper).
 It hooks ``hdwf.fe.cycle``'s mount and ±T settling while it runs to read their contact states.
@@ -83,13 +85,21 @@ def loaded_tooth_pairs(model, level):
 
 
 def tooth_bands(model, level) -> pd.DataFrame:
-    """Loaded tooth pairs of a state: angle from the nearer major axis, slave side, force."""
+    """Loaded tooth pairs of a state: angle from the nearer major axis, slave side, force and
+    its moment on the FS about the axis (N mm, positive with the test torque; from the rows'
+    gap gradient along the FS's rigid rotation, on the rows as the run left them)."""
+    G = model.rows["tooth"].G
+    fs_rotation = model.structure.watch_vector("fs", model.bodies["fs"].modes["rot"])
+    lever = -(G @ fs_rotation)        # a pair pushing the FS with the torque opens as it turns
+    fs_nodes = model.rows["tooth"].slave_nodes[0]
     out = []
     for body, node, side, p in loaded_tooth_pairs(model, level):
         x = model.bodies[body].x[:, node]
         angle = math.degrees(math.atan2(x[1], x[0])) % 180.0
-        out.append((min(angle, 180.0 - angle), side, p))
-    df = pd.DataFrame(out, columns=["angle_deg", "slave", "force_N"])
+        row = int(np.flatnonzero(fs_nodes == node)[0]) if body == "fs" else \
+            fs_nodes.size + int(np.flatnonzero(model.rows["tooth"].slave_nodes[1] == node)[0])
+        out.append((min(angle, 180.0 - angle), side, p, p * lever[row]))
+    df = pd.DataFrame(out, columns=["angle_deg", "slave", "force_N", "moment_Nmm"])
     df["band"] = pd.cut(df["angle_deg"], np.arange(0, 100, 10))
     return df
 
@@ -119,6 +129,9 @@ if __name__ == "__main__":
     ap.add_argument("--design", help="its design_id")
     ap.add_argument("--base", default="", help="without --designs: Table 3's nominal changed, e.g. rFS_mm=0.01")
     ap.add_argument("--preload", default="0,0.157", help="interference_m values (0: the bare section)")
+    ap.add_argument("--flank-layer", type=float, default=0.0,
+                    help="with a preload: the flank layer's thickness in modules (the studies' model: "
+                         "config.yaml's fe.effects)")
     ap.add_argument("--refinement", type=float, default=1.0)
     ap.add_argument("--bands", action="store_true", help="tooth forces per 10° band at the mount and at +T")
     ap.add_argument("--depth", action="store_true",
@@ -133,7 +146,10 @@ if __name__ == "__main__":
     settings = MeshSettings.from_mapping({"elements_over_height": 10, "elements_over_thickness": 6,
                                           "refinement": a.refinement, "symmetry": "half"})
     for delta in (float(x) for x in a.preload.split(",")):
-        changes = model_changes({"preload": {"interference_m": delta}} if delta > 0 else {})
+        effects = {"preload": {"interference_m": delta}} if delta > 0 else {}
+        if delta > 0 and a.flank_layer > 0:
+            effects["flank_layer"] = {"thickness_m": a.flank_layer}
+        changes = model_changes(effects)
         geom = geometry_of(a.unit, params, **changes.geometry_part())
         res, states = solve_recording(geom, settings.mesh(geom), changes)
         model, mounted = states["mount"]
@@ -144,9 +160,14 @@ if __name__ == "__main__":
               f"{res.max_ball_pressure_MPa:.0f} MPa (ISO 76: {ISO76_BALL_PRESSURE_MPA:g} MPa at "
               f"{_iso_load(geom):.0f} N); T / r_p = {geom.torque / geom.r_fs_pitch:.1f} N", flush=True)
         if a.bands and delta > 0 and "+T" in states:
-            at_mount = tooth_bands(*states["mount"]).groupby(["band", "slave"], observed=True)["force_N"].sum()
-            at_plus = tooth_bands(*states["+T"]).groupby(["band", "slave"], observed=True)["force_N"].sum()
-            print(pd.DataFrame({"mount_N": at_mount, "plus_T_N": at_plus}).round(1).to_string(), flush=True)
+            at_mount = tooth_bands(*states["mount"]).groupby(["band", "slave"], observed=True)
+            at_plus = tooth_bands(*states["+T"]).groupby(["band", "slave"], observed=True)
+            table = pd.DataFrame({"mount_N": at_mount["force_N"].sum(), "plus_T_N": at_plus["force_N"].sum(),
+                                  "moment_change_Nmm": at_plus["moment_Nmm"].sum().sub(
+                                      at_mount["moment_Nmm"].sum(), fill_value=0.0)})
+            print(table.round(1).to_string(), flush=True)
+            print(f"  moment change over all bands {table['moment_change_Nmm'].sum():.1f} N mm "
+                  f"(the half model's share of T: {geom.torque / 2:.1f} N mm)", flush=True)
         if a.depth and "+T" in states:
             depths = contact_depths(*states["+T"])
             band = np.floor(depths["depth_m"] * 10) / 10
