@@ -38,8 +38,8 @@ rule validation_diagnosis:
     params:
         plan=plan_dict,
     # an effect found before the next round is re-solved near its estimate, every specimen.
-    # One core and a priority: a two-core job waits until both cores are free at once, which
-    # a queue of one-core solves never leaves, so it ran last and alone; now it runs beside them
+    # One core and a priority: a two-core job would wait until both cores are free at once,
+    # which a queue of one-core solves never leaves, and so run last and alone
     threads: 1
     priority: 2
     resources:
