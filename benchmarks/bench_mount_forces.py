@@ -74,14 +74,14 @@ def kind_sums(level) -> dict[str, float]:
 
 
 def loaded_tooth_pairs(model, level):
-    """The loaded tooth pairs of a state: (body name, slave node, slave side, normal force)."""
+    """The loaded tooth pairs of a state: (tooth row, body name, slave node, slave side, normal force)."""
     fs_nodes, cs_nodes = model.rows["tooth"].slave_nodes
     for (kind, i), p in zip(level.pair_ids, level.normal_force):
         if kind == "tooth" and p > 0:
             if i < fs_nodes.size:
-                yield "fs", fs_nodes[i], "FS flank", p
+                yield i, "fs", fs_nodes[i], "FS flank", p
             else:
-                yield "cs", cs_nodes[i - fs_nodes.size], "CS tip", p
+                yield i, "cs", cs_nodes[i - fs_nodes.size], "CS tip", p
 
 
 def tooth_bands(model, level) -> pd.DataFrame:
@@ -91,13 +91,10 @@ def tooth_bands(model, level) -> pd.DataFrame:
     G = model.rows["tooth"].G
     fs_rotation = model.structure.watch_vector("fs", model.bodies["fs"].modes["rot"])
     lever = -(G @ fs_rotation)        # a pair pushing the FS with the torque opens as it turns
-    fs_nodes = model.rows["tooth"].slave_nodes[0]
     out = []
-    for body, node, side, p in loaded_tooth_pairs(model, level):
+    for row, body, node, side, p in loaded_tooth_pairs(model, level):
         x = model.bodies[body].x[:, node]
         angle = math.degrees(math.atan2(x[1], x[0])) % 180.0
-        row = int(np.flatnonzero(fs_nodes == node)[0]) if body == "fs" else \
-            fs_nodes.size + int(np.flatnonzero(model.rows["tooth"].slave_nodes[1] == node)[0])
         out.append((min(angle, 180.0 - angle), side, p, p * lever[row]))
     df = pd.DataFrame(out, columns=["angle_deg", "slave", "force_N", "moment_Nmm"])
     df["band"] = pd.cut(df["angle_deg"], np.arange(0, 100, 10))
@@ -111,7 +108,7 @@ def contact_depths(model, level) -> pd.DataFrame:
     g = model.geometry
     u = model.full_displacements(level, g.torque)
     out = [(side, math.hypot(*(model.bodies[body].x[:, node] + u[body][:, node])) - g.r_cs_tip, p)
-           for body, node, side, p in loaded_tooth_pairs(model, level)]
+           for _, body, node, side, p in loaded_tooth_pairs(model, level)]
     df = pd.DataFrame(out, columns=["slave", "depth_mm", "force_N"])
     df["depth_m"] = df["depth_mm"] / g.module
     return df
