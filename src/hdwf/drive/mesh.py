@@ -17,16 +17,19 @@ Density follows the paper (Sec. 4): each tooth flank is split into ``elements_ov
 segments and the tooth thickness at the pitch circle into ``elements_over_thickness``;
 the rim grades to about twice that size at the FS bore and to a coarse size at the CS
 outer rim.  ``refinement`` multiplies every element count (divides every size).
-Hand-written parts: only the tooth outlines (involute points from ``hdwf.drive.geometry``) and
-the conversion of gmsh's arrays into per-body scikit-fem meshes.
+The FS and CS are meshed as one tooth period and copied round (``hdwf.drive.sector_mesh``:
+every tooth gets the same nodes); the bearing rings are meshed whole by gmsh.
+Hand-written parts: only the tooth outlines (involute points from ``hdwf.drive.geometry``),
+the copying and the conversion of gmsh's arrays into per-body scikit-fem meshes.
 
 Half model (``symmetry="half"``): the drive is point-symmetric under a rotation by pi
 (even tooth counts, two-lobe cam, even ball count), so only the upper half (angles 0..pi)
-of every body is meshed.  Each body is cut along the x axis; the cut line at angle pi is
-made gmsh-periodic to the one at angle 0 under the rotation by pi, so every node at
-(-x, 0) has a partner at (x, 0) (``hdwf.fe`` ties them, u_partner = -u).  The half
-outlines use the same points, flank and arc node counts as the full ones, so the density
-rule is unchanged.  ``DriveMesh.symmetry`` says which model it is; the flag is also
+of every body is meshed.  Each body is cut along the x axis; the cut at angle pi is the
+image of the one at angle 0 under the rotation by pi (gmsh-periodic on the bearing rings, by
+construction on the toothed rings, whose cuts run through the middle of a FS tooth or CS
+space), so every node at (-x, 0) has a partner at (x, 0) (``hdwf.fe`` ties them,
+u_partner = -u).  The half model uses the same period and ring node counts as the full one,
+so the density rule is unchanged.  ``DriveMesh.symmetry`` says which model it is; the flag is also
 recorded as ``sizes["symmetry_half"] = 1.0`` so that it survives storage of ``sizes``.
 """
 
@@ -41,6 +44,7 @@ from skfem import MeshTri
 
 from hdwf.drive.geometry import DriveGeometry, cs_half_space_angle, fs_half_angle
 from hdwf.drive.relief import relief_start_depth
+from hdwf.drive.sector_mesh import RingProfile, RingSizes, copy_round, mesh_period
 
 MESH_ALGORITHM = 6   # gmsh 2D: 6 = Frontal-Delaunay (quality); 5 = Delaunay
 LC_INTEGRATION_PRECISION = 1e-6   # relative precision of the size integral along a curve
@@ -112,89 +116,6 @@ def _relieved_radii(g: DriveGeometry, r0: float, r1: float, r_tip: float) -> np.
     return rr if r1 > r0 else rr[::-1]
 
 
-def _toothed_outline(geo, z: int, rr: np.ndarray, half_angle: np.ndarray, c: int,
-                     size: float) -> tuple[list[int], list[int]]:
-    """Closed toothed outline (counter-clockwise) of z teeth or spaces centred on 2 pi i / z.
-
-    Each period: the clockwise flank at angles -half_angle(r) over the radii ``rr``, an arc
-    across (FS tooth tip or CS space root), the other flank back, then the land to the next
-    period. Returns (curves, flanks).
-    """
-    curves, flanks = [], []
-    first_pt = prev_pt = None
-    for i in range(z):
-        th = 2 * math.pi * i / z
-        pa = [geo.addPoint(r * math.cos(t), r * math.sin(t), 0.0, size) for r, t in zip(rr, th - half_angle)]
-        if prev_pt is not None:     # land from the previous period
-            curves.append(geo.addCircleArc(prev_pt, c, pa[0]))
-        else:
-            first_pt = pa[0]
-        fa = geo.addSpline(pa)
-        pb = [geo.addPoint(r * math.cos(t), r * math.sin(t), 0.0, size)
-              for r, t in zip(rr[::-1], (th + half_angle)[::-1])]
-        across = geo.addCircleArc(pa[-1], c, pb[0])
-        fb = geo.addSpline(pb)
-        curves += [fa, across, fb]
-        flanks += [fa, fb]
-        prev_pt = pb[-1]
-    curves.append(geo.addCircleArc(prev_pt, c, first_pt))
-    return curves, flanks
-
-
-def _toothed_half_outline(geo, z: int, rr: np.ndarray, half_angle: np.ndarray, c: int,
-                          size: float):
-    """Upper half (angles 0..pi) of ``_toothed_outline``: the same points, starting at the
-    middle of period 0 (angle 0, radius rr[-1]) and ending at the middle of period z/2
-    (angle pi).  Returns (curves, flanks, first point, last point)."""
-    zh = z // 2
-    curves, flanks = [], []
-    rc = float(rr[-1])
-    p0 = geo.addPoint(rc, 0.0, 0.0, size)
-    pe = None
-    prev = None
-    for i in range(zh + 1):
-        th = 2 * math.pi * i / z
-        if i > 0:
-            pa = [geo.addPoint(r * math.cos(t), r * math.sin(t), 0.0, size)
-                  for r, t in zip(rr, th - half_angle)]
-            curves.append(geo.addCircleArc(prev, c, pa[0]))
-            fa = geo.addSpline(pa)
-            curves.append(fa)
-            flanks.append(fa)
-            if i == zh:
-                pe = geo.addPoint(-rc, 0.0, 0.0, size)
-                curves.append(geo.addCircleArc(pa[-1], c, pe))
-                break
-        pb = [geo.addPoint(r * math.cos(t), r * math.sin(t), 0.0, size)
-              for r, t in zip(rr[::-1], (th + half_angle)[::-1])]
-        curves.append(geo.addCircleArc(p0 if i == 0 else pa[-1], c, pb[0]))
-        fb = geo.addSpline(pb)
-        curves.append(fb)
-        flanks.append(fb)
-        prev = pb[-1]
-    return curves, flanks, p0, pe
-
-
-def _half_circle(geo, r: float, size: float, c: int):
-    """Upper half circle as 2 arcs 0 -> pi/2 -> pi (the full circle's first two arcs)."""
-    pts = [geo.addPoint(r * math.cos(a), r * math.sin(a), 0.0, size)
-           for a in np.arange(3) * math.pi / 2]
-    return [geo.addCircleArc(pts[0], c, pts[1]), geo.addCircleArc(pts[1], c, pts[2])], pts
-
-
-def _fs_outline(geo, g: DriveGeometry, c: int, s: dict) -> tuple[list[int], list[int]]:
-    """Outer outline of the FS: teeth centred on 2 pi i / z_FS, flanks root -> tip."""
-    rr = _relieved_radii(g, g.r_fs_root, g.r_fs_tip, g.r_fs_tip)
-    return _toothed_outline(geo, g.z_fs, rr, fs_half_angle(g, rr), c, s["tooth"])
-
-
-def _cs_outline(geo, g: DriveGeometry, c: int, s: dict) -> tuple[list[int], list[int]]:
-    """Inner outline of the CS: spaces centred on 2 pi j / z_CS so that FS tooth 0 (angle 0)
-    enters CS space 0 at the major axis; flanks tip -> root."""
-    rr = _relieved_radii(g, g.r_cs_tip, g.r_cs_root, g.r_cs_tip)
-    return _toothed_outline(geo, g.z_cs, rr, cs_half_space_angle(g, rr), c, s["tooth"])
-
-
 BODY_NAMES = ("fs", "cs", "ir", "or")
 
 
@@ -212,8 +133,8 @@ def build_mesh(geom: DriveGeometry, elements_over_height: int = 10,
     path : where gmsh writes its binary ``.msh`` (for review), or None.
     symmetry : ``"half"`` meshes only the upper half of every body (see the module
         docstring); ``"full"`` (default) the whole drive.
-    bodies : the bodies to mesh.  Each body has its own curves and surface, so a body meshed
-        alone gets the same nodes and triangles as in the whole drive (``share_bodies``).
+    bodies : the bodies to mesh.  Each body is meshed on its own, so a body meshed alone is
+        the same as in the whole drive (``share_bodies``).
 
     Returns
     -------
@@ -233,37 +154,17 @@ def build_mesh(geom: DriveGeometry, elements_over_height: int = 10,
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.option.setNumber("General.NumThreads", 1)
-        gmsh.model.add("hd")
-        geo = gmsh.model.geo
-        c = geo.addPoint(0, 0, 0, 1.0)
-        groups: dict[str, tuple[int, list[int]]] = {}
-        cuts: list[tuple[int, int]] = []     # (line at angle pi, line at angle 0)
-        build = _half_geometry if half else _full_geometry
-        curves = build(geo, g, c, s, groups, cuts, set(bodies))
-        geo.synchronize()
-        _mesh_controls(g, s, curves, cuts)
-        for name, (dim, tags) in groups.items():
-            gmsh.model.addPhysicalGroup(dim, tags, name=name)
-        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 1)
-        gmsh.option.setNumber("Mesh.Algorithm", MESH_ALGORITHM)
-        # gmsh integrates the size along every curve to 1e-9 by default, a third of the meshing
-        # time on ~1000 tooth curves; 1e-6 of a segment changes no size that matters
-        gmsh.option.setNumber("Mesh.LcIntegrationPrecision", LC_INTEGRATION_PRECISION)
-        gmsh.model.mesh.generate(2)
+        meshes = {name: _toothed_body(name, g, s, half) for name in ("fs", "cs") if name in bodies}
+        rings = tuple(name for name in ("ir", "or") if name in bodies)
+        if rings:
+            meshes.update(_bearing_rings(g, s, half, rings))
         if path is not None:
-            gmsh.option.setNumber("Mesh.Binary", 1)  # 4x smaller and faster to write; gmsh reads it back
-            gmsh.write(str(path))
-        ntags, coords, _ = gmsh.model.mesh.getNodes()
-        xy = np.zeros((int(ntags.max()) + 1, 2))
-        xy[ntags.astype(np.int64)] = coords.reshape(-1, 3)[:, :2]
-        meshes = {name: _extract_body(name, groups, xy, thick, bnames) for name, thick, bnames in (
-            ("fs", g.face_fs, ["fs_teeth", "fs_bore"]), ("cs", g.face_cs, ["cs_teeth", "cs_outer"]),
-            ("ir", g.B, ["ir_bore", "ir_race"]), ("or", g.B, ["or_race", "or_outer"])) if name in bodies}
+            _write_review(str(path), meshes)
     finally:
         gmsh.finalize()
     if half:
         s["symmetry_half"] = 1.0
-    return DriveMesh(meshes, s, symmetry)
+    return DriveMesh({name: meshes[name] for name in BODY_NAMES if name in meshes}, s, symmetry)
 
 
 def share_bodies(fs_mesh: DriveMesh, others: DriveMesh) -> DriveMesh:
@@ -276,28 +177,94 @@ def share_bodies(fs_mesh: DriveMesh, others: DriveMesh) -> DriveMesh:
                      dict(others.sizes), others.symmetry)
 
 
-def _mesh_controls(g: DriveGeometry, s: dict, curves: tuple, cuts: list) -> None:
-    """Periodic cuts (half model), transfinite flanks and uniform spacing on circular contacts."""
-    fs_fl, cs_fl, fs_bore, ir_bore, ir_race, or_race, or_outer, cs_outer = curves
-    # half model: the cut at angle pi is the image of the cut at angle 0 under the
-    # rotation by pi, so their nodes pair up exactly (u_pi = -u_0 in hdwf.fe)
+def _toothed_body(name: str, g: DriveGeometry, s: dict, half: bool) -> BodyMesh:
+    """The FS (teeth centred on 2 pi i / z_FS, flanks root -> tip) or the CS (spaces centred on
+    2 pi j / z_CS, so that FS tooth 0 enters CS space 0 at the major axis), one period meshed
+    and copied round (``hdwf.drive.sector_mesh``)."""
+    if name == "fs":
+        rr = _relieved_radii(g, g.r_fs_root, g.r_fs_tip, g.r_fs_tip)
+        prof = RingProfile(g.z_fs, rr, fs_half_angle(g, rr), g.r_fs_bore, "fs_teeth", "fs_bore")
+        sizes, thickness = RingSizes(s["tooth"], s["fs_bore"], int(s["n_flank"])), g.face_fs
+    else:
+        rr = _relieved_radii(g, g.r_cs_tip, g.r_cs_root, g.r_cs_tip)
+        prof = RingProfile(g.z_cs, rr, cs_half_space_angle(g, rr), g.r_cs_outer, "cs_teeth", "cs_outer")
+        sizes, thickness = RingSizes(s["tooth"], s["cs_outer"], int(s["n_flank"])), g.face_cs
+    sector = mesh_period(prof, sizes, MESH_ALGORITHM, LC_INTEGRATION_PRECISION)
+    p, t, edges = copy_round(sector, prof.z, half)
+    bm = BodyMesh(name, MeshTri(p, _counter_clockwise(p, t)), thickness)
+    for group, e in edges.items():
+        bm.edge_sets[group], bm.node_sets[group] = e, np.unique(e)
+    return bm
+
+
+def _counter_clockwise(p: np.ndarray, t: np.ndarray) -> np.ndarray:
+    t = t.copy()
+    a = ((p[0, t[1]] - p[0, t[0]]) * (p[1, t[2]] - p[1, t[0]])
+         - (p[0, t[2]] - p[0, t[0]]) * (p[1, t[1]] - p[1, t[0]]))
+    sw = a < 0
+    t[1, sw], t[2, sw] = t[2, sw].copy(), t[1, sw].copy()
+    return t
+
+
+def _bearing_rings(g: DriveGeometry, s: dict, half: bool, rings: tuple[str, ...]) -> dict[str, BodyMesh]:
+    """The bearing's inner and outer ring (those in ``rings``), meshed by gmsh as whole rings or
+    upper halves with uniform node spacing on their circles."""
+    gmsh.model.add("bearing")
+    geo = gmsh.model.geo
+    c = geo.addPoint(0, 0, 0, 1.0)
+    groups: dict[str, tuple[int, list[int]]] = {}
+    cuts: list[tuple[int, int]] = []     # (line at angle pi, line at angle 0)
+    spec = {"ir": (g.ir_bore, g.ir_race, "ir_bore", "ir_race"), "or": (g.or_race, g.or_outer, "or_race", "or_outer")}
+    circles = []
+    for name in rings:
+        r_in, r_out, g_in, g_out = spec[name]
+        surf, inner, outer = (_half_ring if half else _whole_ring)(geo, c, r_in, r_out, s["ring"], cuts)
+        groups.update({name: (2, [surf]), g_in: (1, inner), g_out: (1, outer)})
+        circles += [(inner, r_in), (outer, r_out)]
+    geo.synchronize()
+    # half model: the cut at angle pi is the image of the cut at angle 0 under the rotation by
+    # pi, so their nodes pair up exactly (u_pi = -u_0 in hdwf.fe)
     rot_pi = [-1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
     for slave, master in cuts:
         gmsh.model.mesh.setPeriodic(1, [slave], [master], rot_pi)
-    # transfinite flanks: exactly n_flank segments over the tooth height
-    for cv in fs_fl + cs_fl:
-        gmsh.model.mesh.setTransfiniteCurve(cv, s["n_flank"] + 1)
-
-    # uniform node spacing on the circular contact surfaces (mortar bins need no
-    # matching, but uniform spacing keeps the bin weights even)
-    def uniform(arcs, r, h):
-        n = max(2, int(math.ceil(0.5 * math.pi * r / h)))
+    # uniform node spacing on the circular contact surfaces (mortar bins need no matching, but
+    # uniform spacing keeps the bin weights even)
+    for arcs, r in circles:
+        n = max(2, int(math.ceil(0.5 * math.pi * r / s["ring"])))
         for a in arcs:
             gmsh.model.mesh.setTransfiniteCurve(a, n + 1)
-    uniform(fs_bore, g.r_fs_bore, s["fs_bore"])
-    for arcs, r in ((ir_bore, g.ir_bore), (ir_race, g.ir_race), (or_race, g.or_race), (or_outer, g.or_outer)):
-        uniform(arcs, r, s["ring"])
-    uniform(cs_outer, g.r_cs_outer, s["cs_outer"])
+    for name, (dim, tags) in groups.items():
+        gmsh.model.addPhysicalGroup(dim, tags, name=name)
+    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 1)
+    gmsh.option.setNumber("Mesh.Algorithm", MESH_ALGORITHM)
+    gmsh.option.setNumber("Mesh.LcIntegrationPrecision", LC_INTEGRATION_PRECISION)
+    gmsh.model.mesh.generate(2)
+    ntags, coords, _ = gmsh.model.mesh.getNodes()
+    xy = np.zeros((int(ntags.max()) + 1, 2))
+    xy[ntags.astype(np.int64)] = coords.reshape(-1, 3)[:, :2]
+    return {name: _extract_body(name, groups, xy, g.B, list(spec[name][2:])) for name in rings}
+
+
+def _write_review(path: str, meshes: dict[str, BodyMesh]) -> None:
+    """Write the bodies into one binary gmsh ``.msh`` (for review), each a discrete surface
+    with its named boundaries as physical groups."""
+    gmsh.model.add("review")
+    offset = 0
+    for name, bm in meshes.items():
+        p, t = bm.mesh.p, bm.mesh.t
+        tags = offset + 1 + np.arange(p.shape[1])
+        surf = gmsh.model.addDiscreteEntity(2)
+        xyz = np.vstack([p, np.zeros(p.shape[1])]).T.ravel()
+        gmsh.model.mesh.addNodes(2, surf, tags, xyz)
+        gmsh.model.mesh.addElementsByType(surf, 2, [], tags[t.T].ravel())
+        gmsh.model.addPhysicalGroup(2, [surf], name=name)
+        for group, e in bm.edge_sets.items():
+            line = gmsh.model.addDiscreteEntity(1)
+            gmsh.model.mesh.addElementsByType(line, 1, [], tags[e].ravel())
+            gmsh.model.addPhysicalGroup(1, [line], name=group)
+        offset += p.shape[1]
+    gmsh.option.setNumber("Mesh.Binary", 1)  # 4x smaller and faster to write; gmsh reads it back
+    gmsh.write(path)
 
 
 def _extract_body(name: str, groups: dict, xy: np.ndarray, thickness: float, boundary_names: list[str]) -> BodyMesh:
@@ -309,12 +276,7 @@ def _extract_body(name: str, groups: dict, xy: np.ndarray, thickness: float, bou
     loc = -np.ones(xy.shape[0], dtype=np.int64)
     loc[used] = np.arange(used.size)
     p = xy[used].T.copy()
-    t = loc[tri].T.copy()
-    a = ((p[0, t[1]] - p[0, t[0]]) * (p[1, t[2]] - p[1, t[0]])
-         - (p[0, t[2]] - p[0, t[0]]) * (p[1, t[1]] - p[1, t[0]]))
-    sw = a < 0
-    t[1, sw], t[2, sw] = t[2, sw].copy(), t[1, sw].copy()
-    bm = BodyMesh(name, MeshTri(p, t), thickness)
+    bm = BodyMesh(name, MeshTri(p, _counter_clockwise(p, loc[tri].T)), thickness)
     for bn in boundary_names:
         edges = []
         for cv in groups[bn][1]:
@@ -326,77 +288,27 @@ def _extract_body(name: str, groups: dict, xy: np.ndarray, thickness: float, bou
     return bm
 
 
-def _full_geometry(geo, g: DriveGeometry, c: int, s: dict, groups: dict, cuts: list, bodies: set):
-    """The whole bodies named in ``bodies`` (FS, CS, bearing inner and outer ring); fills ``groups``.
-
-    ``cuts`` stays empty (no symmetry cut); same signature and return as ``_half_geometry``
-    (the curves of a body not built are empty)."""
-    fs_fl = cs_fl = fs_bore = cs_outer = ir_bore = ir_race = or_race = or_outer = []
-    if "fs" in bodies:
-        fs_out, fs_fl = _fs_outline(geo, g, c, s)
-        fs_bore = _circle(geo, g.r_fs_bore, s["fs_bore"], c)
-        fs_surf = geo.addPlaneSurface([geo.addCurveLoop(fs_out), geo.addCurveLoop(fs_bore)])
-        groups.update({"fs": (2, [fs_surf]), "fs_teeth": (1, fs_out), "fs_bore": (1, fs_bore)})
-    if "cs" in bodies:
-        cs_in, cs_fl = _cs_outline(geo, g, c, s)
-        cs_outer = _circle(geo, g.r_cs_outer, s["cs_outer"], c)
-        cs_surf = geo.addPlaneSurface([geo.addCurveLoop(cs_outer), geo.addCurveLoop(cs_in)])
-        groups.update({"cs": (2, [cs_surf]), "cs_teeth": (1, cs_in), "cs_outer": (1, cs_outer)})
-    if "ir" in bodies:
-        ir_bore = _circle(geo, g.ir_bore, s["ring"], c)
-        ir_race = _circle(geo, g.ir_race, s["ring"], c)
-        ir_surf = geo.addPlaneSurface([geo.addCurveLoop(ir_race), geo.addCurveLoop(ir_bore)])
-        groups.update({"ir": (2, [ir_surf]), "ir_bore": (1, ir_bore), "ir_race": (1, ir_race)})
-    if "or" in bodies:
-        or_race = _circle(geo, g.or_race, s["ring"], c)
-        or_outer = _circle(geo, g.or_outer, s["ring"], c)
-        or_surf = geo.addPlaneSurface([geo.addCurveLoop(or_outer), geo.addCurveLoop(or_race)])
-        groups.update({"or": (2, [or_surf]), "or_race": (1, or_race), "or_outer": (1, or_outer)})
-    return fs_fl, cs_fl, fs_bore, ir_bore, ir_race, or_race, or_outer, cs_outer
+def _whole_ring(geo, c: int, r_in: float, r_out: float, size: float, cuts: list):
+    """A whole annulus: its surface and its inner and outer arcs (``cuts`` unused)."""
+    inner, outer = _circle(geo, r_in, size, c), _circle(geo, r_out, size, c)
+    return geo.addPlaneSurface([geo.addCurveLoop(outer), geo.addCurveLoop(inner)]), inner, outer
 
 
-def _half_geometry(geo, g: DriveGeometry, c: int, s: dict, groups: dict, cuts: list, bodies: set):
-    """Upper halves of the bodies named in ``bodies``, each closed by two radial cut lines on
-    the x axis (inner -> outer radius at angle 0 and at angle pi); fills ``groups`` and ``cuts``."""
-    def cut_pair(p_in0, p_out0, p_in1, p_out1):
-        l0 = geo.addLine(p_in0, p_out0)
-        l1 = geo.addLine(p_in1, p_out1)
-        cuts.append((l1, l0))
-        return l0, l1
+def _half_circle(geo, r: float, size: float, c: int):
+    """Upper half circle as 2 arcs 0 -> pi/2 -> pi (the full circle's first two arcs)."""
+    pts = [geo.addPoint(r * math.cos(a), r * math.sin(a), 0.0, size)
+           for a in np.arange(3) * math.pi / 2]
+    return [geo.addCircleArc(pts[0], c, pts[1]), geo.addCircleArc(pts[1], c, pts[2])], pts
 
-    fs_fl = cs_fl = fs_bore = cs_outer = ir_bore = ir_race = or_race = or_outer = []
-    if "fs" in bodies:    # toothed outline 0 -> pi, bore pi -> 0
-        rr = _relieved_radii(g, g.r_fs_root, g.r_fs_tip, g.r_fs_tip)
-        fs_out, fs_fl, o0, o1 = _toothed_half_outline(geo, g.z_fs, rr, fs_half_angle(g, rr), c,
-                                                      s["tooth"])
-        fs_bore, bp = _half_circle(geo, g.r_fs_bore, s["fs_bore"], c)
-        l0, l1 = cut_pair(bp[0], o0, bp[2], o1)
-        loop = fs_out + [-l1] + [-a for a in fs_bore[::-1]] + [l0]
-        fs_surf = geo.addPlaneSurface([geo.addCurveLoop(loop)])
-        groups.update({"fs": (2, [fs_surf]), "fs_teeth": (1, fs_out), "fs_bore": (1, fs_bore)})
-    if "cs" in bodies:    # outer rim 0 -> pi, toothed inner outline pi -> 0
-        rr = _relieved_radii(g, g.r_cs_tip, g.r_cs_root, g.r_cs_tip)
-        cs_in, cs_fl, i0, i1 = _toothed_half_outline(geo, g.z_cs, rr, cs_half_space_angle(g, rr),
-                                                     c, s["tooth"])
-        cs_outer, op = _half_circle(geo, g.r_cs_outer, s["cs_outer"], c)
-        l0, l1 = cut_pair(i0, op[0], i1, op[2])
-        loop = [l0] + cs_outer + [-l1] + [-a for a in cs_in[::-1]]
-        cs_surf = geo.addPlaneSurface([geo.addCurveLoop(loop)])
-        groups.update({"cs": (2, [cs_surf]), "cs_teeth": (1, cs_in), "cs_outer": (1, cs_outer)})
 
-    def ring(r_in, r_out):
-        inner, ip = _half_circle(geo, r_in, s["ring"], c)
-        outer, op = _half_circle(geo, r_out, s["ring"], c)
-        l0, l1 = cut_pair(ip[0], op[0], ip[2], op[2])
-        loop = [l0] + outer + [-l1] + [-a for a in inner[::-1]]
-        return geo.addPlaneSurface([geo.addCurveLoop(loop)]), inner, outer
-    if "ir" in bodies:
-        ir_surf, ir_bore, ir_race = ring(g.ir_bore, g.ir_race)
-        groups.update({"ir": (2, [ir_surf]), "ir_bore": (1, ir_bore), "ir_race": (1, ir_race)})
-    if "or" in bodies:
-        or_surf, or_race, or_outer = ring(g.or_race, g.or_outer)
-        groups.update({"or": (2, [or_surf]), "or_race": (1, or_race), "or_outer": (1, or_outer)})
-    return fs_fl, cs_fl, fs_bore, ir_bore, ir_race, or_race, or_outer, cs_outer
+def _half_ring(geo, c: int, r_in: float, r_out: float, size: float, cuts: list):
+    """The upper half of an annulus, closed by radial cuts at angle 0 and pi (added to ``cuts``)."""
+    inner, ip = _half_circle(geo, r_in, size, c)
+    outer, op = _half_circle(geo, r_out, size, c)
+    l0, l1 = geo.addLine(ip[0], op[0]), geo.addLine(ip[2], op[2])
+    cuts.append((l1, l0))
+    loop = [l0] + outer + [-l1] + [-a for a in inner[::-1]]
+    return geo.addPlaneSurface([geo.addCurveLoop(loop)]), inner, outer
 
 
 def annulus_mesh(r_in: float, r_out: float, size: float) -> BodyMesh:
@@ -421,12 +333,8 @@ def annulus_mesh(r_in: float, r_out: float, size: float) -> BodyMesh:
         used = np.unique(tri)
         loc = -np.ones(xy.shape[0], dtype=np.int64)
         loc[used] = np.arange(used.size)
-        p, t = xy[used].T.copy(), loc[tri].T.copy()
-        a = ((p[0, t[1]] - p[0, t[0]]) * (p[1, t[2]] - p[1, t[0]])
-             - (p[0, t[2]] - p[0, t[0]]) * (p[1, t[1]] - p[1, t[0]]))
-        sw = a < 0
-        t[1, sw], t[2, sw] = t[2, sw].copy(), t[1, sw].copy()
-        bm = BodyMesh("ring", MeshTri(p, t), 1.0)
+        p = xy[used].T.copy()
+        bm = BodyMesh("ring", MeshTri(p, _counter_clockwise(p, loc[tri].T)), 1.0)
         for name, arcs in (("inner", inner), ("outer", outer)):
             edges = []
             for cv in arcs:
