@@ -41,12 +41,16 @@ def test_elastic_effect_found_at_two_percent_noise_on_a_dense_catalogue_grade_ba
     """A batch of catalogue-grade drives (lost motion about 1.15 arcmin) logged at 201 points
     per curve: 2 % of its lost motion is 0.023 arcmin (1.4 arcsec) per reading. Cup torsion
     (expected sd of K 1.4 %), housing compliance (4 %) and flank friction at mu 0.1 (10 %) are
-    each named first, with no look-alike, and recovered within 15 %."""
+    each named first and recovered within 15 %. Housing compliance and friction have no
+    look-alike; cup torsion's data fit housing compliance almost as well (ΔBIC -2572.0 against
+    -2566.3, within the tie threshold of 6), so housing may be named beside it."""
     diag = hidden_one(tmp_path, batch_specimens, dense_tables, effect, 0.02 * batch_signal, DENSE_STEPS, BATCH,
                        BATCH_VALUES)
-    # stricter than the issue's "first or among the indistinguishable": on this batch each
-    # stands clear of the runner-up by more than the tie threshold (ΔBIC 6)
-    assert diag["verdict"]["missing_effect"] == effect and diag["verdict"]["indistinguishable_from"] == []
+    # stricter than the issue's "first or among the indistinguishable": named first, and a
+    # look-alike only where the two compliances fit alike
+    look_alikes = {"fs_cup_torsion": {"cs_housing"}}.get(effect, set())
+    assert diag["verdict"]["missing_effect"] == effect
+    assert set(diag["verdict"]["indistinguishable_from"]) <= look_alikes
 
 
 def test_two_hidden_effects_found_in_two_rounds(tmp_path, batch_specimens, dense_tables, batch_signal):
