@@ -47,7 +47,7 @@ def test_copies_are_joined_and_only_the_named_outlines_are_boundary(geom, symmet
         p, t = mesh.p, mesh.t
         return 0.5 * np.sum((p[0, t[1]] - p[0, t[0]]) * (p[1, t[2]] - p[1, t[0]])
                             - (p[0, t[2]] - p[0, t[0]]) * (p[1, t[1]] - p[1, t[0]]))
-    assert area(fs_full) == pytest.approx(2.0 * area(fs_half), rel=1e-12)
+    assert area(fs_full) == pytest.approx(2.0 * area(fs_half), rel=1e-9)   # a triangle is 3e-5 of it
 
 
 def test_every_tooth_has_the_same_nodes(geom):

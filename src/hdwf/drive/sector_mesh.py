@@ -87,42 +87,51 @@ def mesh_period(prof: RingProfile, sizes: RingSizes, algorithm: int, lc_precisio
     for cv in flanks:
         gmsh.model.mesh.setTransfiniteCurve(cv, sizes.n_flank + 1)
     gmsh.model.mesh.setTransfiniteCurve(plain, max(1, math.ceil(alpha * prof.r_plain / sizes.plain)) + 1)
-    # the size grows linearly in radius across the rim, from the teeth's to the closing circle's
-    # (a period is too narrow for sizes extended from its boundary to grade like a whole ring's)
-    r_start = min((float(rr[0]), rc), key=lambda r: abs(r - prof.r_plain))
+    _rim_size_field(prof, sizes)
+    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+    gmsh.option.setNumber("Mesh.Algorithm", algorithm)
+    gmsh.option.setNumber("Mesh.LcIntegrationPrecision", lc_precision)
+    gmsh.model.mesh.generate(2)
+    p, t, edges_of = _read_period(surf)
+    edges = {prof.outline_group: edges_of(outline), prof.plain_group: edges_of([plain])}
+    return SectorMesh(p, t, edges, _cut_nodes(p, edges_of([cut0])), _cut_nodes(p, edges_of([cut1])))
+
+
+def _rim_size_field(prof: RingProfile, sizes: RingSizes) -> None:
+    """The element size: the teeth's up to the root circle, then growing linearly in radius to
+    the closing circle's (a period is too narrow for sizes extended from its boundary to grade
+    like a whole ring's)."""
+    rc = float(prof.rr[-1])
+    r_start = min((float(prof.rr[0]), rc), key=lambda r: abs(r - prof.r_plain))   # the root circle
     depth = prof.r_plain - r_start            # signed: toward the closing circle
     field = gmsh.model.mesh.field.add("MathEval")
     gmsh.model.mesh.field.setString(field, "F", (
         f"({sizes.tooth!r}) + ({sizes.plain - sizes.tooth!r}) * Max(0, (Sqrt(x*x + y*y) - ({r_start!r})) / ({depth!r}))"))
     gmsh.model.mesh.field.setAsBackgroundMesh(field)
-    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-    gmsh.option.setNumber("Mesh.Algorithm", algorithm)
-    gmsh.option.setNumber("Mesh.LcIntegrationPrecision", lc_precision)
-    gmsh.model.mesh.generate(2)
 
+
+def _read_period(surf: int):
+    """The meshed period's nodes (2, n) and triangles (3, k), local numbering (the arcs' centre
+    point, in no triangle, left out), and a function giving the edges of some curves."""
     tags, coords, _ = gmsh.model.mesh.getNodes()
     xy = np.zeros((2, int(tags.max()) + 1))
     xy[:, tags.astype(np.int64)] = coords.reshape(-1, 3)[:, :2].T
     et, _, en = gmsh.model.mesh.getElements(2, surf)
     tri = np.asarray(en[list(et).index(2)], dtype=np.int64).reshape(-1, 3)
-    used = np.unique(tri)                  # not the arcs' centre point
+    used = np.unique(tri)
     loc = -np.ones(xy.shape[1], dtype=np.int64)
     loc[used] = np.arange(used.size)
-    p, t = xy[:, used].copy(), loc[tri].T.copy()
 
-    def curve_edges(curves):
+    def edges_of(curves):
         out = []
         for cv in curves:
             et1, _, en1 = gmsh.model.mesh.getElements(1, abs(cv))
             out.append(loc[np.asarray(en1[list(et1).index(1)], dtype=np.int64).reshape(-1, 2)])
         return np.vstack(out)
-
-    edges = {prof.outline_group: curve_edges(outline), prof.plain_group: curve_edges([plain])}
-    c0, c1 = _cut_nodes(p, curve_edges([cut0]), alpha), _cut_nodes(p, curve_edges([cut1]), alpha)
-    return SectorMesh(p, t, edges, c0, c1)
+    return xy[:, used].copy(), loc[tri].T.copy(), edges_of
 
 
-def _cut_nodes(p: np.ndarray, edges: np.ndarray, alpha: float) -> np.ndarray:
+def _cut_nodes(p: np.ndarray, edges: np.ndarray) -> np.ndarray:
     """A cut's nodes ordered by radius."""
     nodes = np.unique(edges)
     return nodes[np.argsort(np.hypot(*p[:, nodes]))]
