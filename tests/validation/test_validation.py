@@ -243,7 +243,8 @@ def test_an_anchored_response_is_exact_at_the_grid_and_off_at_zero():
 
 def test_a_failed_anchor_solve_keeps_the_table_and_says_so():
     """A solve that raises, or returns a failed status, must not lose the diagnosis: the
-    table's response is kept, the estimate is the table's, and the log names the failure."""
+    table's response is kept, the estimate is the table's, and the log names the failure (and
+    the specimen whose solve failed)."""
     table, obs, twist, solve, _ = _kinked_thermal()
     S0, D = twist({}), twist({"thermal": {"delta_T_K": 17.0}})
 
@@ -255,7 +256,7 @@ def test_a_failed_anchor_solve_keeps_the_table_and_says_so():
         out["twist_arcmin"], out["status"] = np.nan, "failed: no convergence"
         return out
 
-    for bad, reason in ((crashes, "RuntimeError: worker died"), (fails, "failed: no convergence")):
+    for bad, reason in ((crashes, "RuntimeError: worker died"), (fails, "(s1, ")):
         resp = responses(table, obs, {}, ["thermal"])
         data = CalibrationData(D, S0, resp)
         plain = calibrate(data, ["thermal"])
@@ -264,6 +265,8 @@ def test_a_failed_anchor_solve_keeps_the_table_and_says_so():
         assert fit.t[0] == plain.t[0] and resp["thermal"].anchor is None
         assert log["thermal"].status == "failed" and reason in log["thermal"].reason
         assert "the table's response is used" in log["thermal"].reason
+        if bad is fails:
+            assert "failed: no convergence" in log["thermal"].reason
 
 
 def test_anchor_points_of_a_stiffness_stay_inside_its_values():

@@ -375,8 +375,10 @@ def anchored_responses(resolver: Resolver, t_hat: dict[str, float]) -> dict[str,
     for e, (ts, variants) in plan.items():
         S = np.array([predict(tab, resolver.obs, variant_key(v)) for v in variants])
         if not np.isfinite(S).all():
-            bad = sorted(set(tab.loc[tab["status"] != "ok", "status"]))
-            out[e] = "the solve failed" + (f" ({bad[0]})" if bad else "")
+            bad = tab.loc[tab["status"] != "ok"].drop_duplicates("specimen_id")
+            out[e] = "the solve failed" + (
+                f" ({bad['specimen_id'].iloc[0]}, {bad['variant'].iloc[0]}: {bad['status'].iloc[0]})"
+                if len(bad) else "")
             continue
         r = resolver.table_resp[e]
         out[e] = Response(r.effect, r.param, r.t, r.S, r.t_bounds, off=r.off, anchor=(ts, S))
