@@ -86,6 +86,37 @@ def test_iteration_limit_gives_failed_status():
     assert math.isnan(r.lost_motion_arcmin)
 
 
+def test_a_level_that_needs_more_iterations_is_solved_at_the_last_try(monkeypatch):
+    """A torque level whose active set fills too slowly for the iteration limit, at every cut-back,
+    is solved once more with LAST_TRY_ITER_FACTOR times the limit: the result is the one an
+    unlimited solve gives (frictionless: the same states, reached through the cut-backs' levels,
+    to the 0.1 % the balls' Hertz secants are iterated to), and a limit that the last try cannot
+    meet either still fails, naming it."""
+    from hdwf.fe import solver as solver_module
+    from hdwf.fe.model import LAST_TRY_ITER_FACTOR
+    args = ("hd42", 31.0, 42.0, 0.015, 0.005, 0.005)
+    reference = _run(*args, symmetry="half")
+    solve_level = solver_module.ContactSolver.solve_level
+
+    def slow_above_zero(limit):
+        def patched(self, structure, rows, modes, torque, active):
+            if isinstance(torque, float) and abs(torque) > 1.0 and self.settings.max_iter <= limit:
+                raise solver_module.ContactFailure(
+                    f"active-set iteration did not converge in {self.settings.max_iter} iterations")
+            return solve_level(self, structure, rows, modes, torque, active)
+        return patched
+
+    monkeypatch.setattr(solver_module.ContactSolver, "solve_level", slow_above_zero(200))
+    r = _run.__wrapped__(*args, symmetry="half")
+    assert r.status == "ok", r.reason
+    assert r.lost_motion_arcmin == pytest.approx(reference.lost_motion_arcmin, rel=1e-3)
+    monkeypatch.setattr(solver_module.ContactSolver, "solve_level",
+                        slow_above_zero(200 * LAST_TRY_ITER_FACTOR))
+    r = _run.__wrapped__(*args, symmetry="half")
+    assert r.status == "failed" and f"in {200 * LAST_TRY_ITER_FACTOR} iterations" in r.reason
+    assert math.isnan(r.lost_motion_arcmin)
+
+
 @pytest.mark.slow
 def test_hd120_phi_at_least_the_rigid_backlash():
     """HD 120 nominal (offsets 25 + 25 um): elasticity and bearing clearance can only add

@@ -29,6 +29,10 @@ from hdwf.fe.working_set import WorkingSet
 
 ZONE_DEG = 35.0   # half width (deg) of the tooth zones about the major axes solved by default
 LEVEL_CUTBACKS = 2   # a load level that does not converge is reached in up to 2 halvings of its step
+# ... and the deepest of them, if it still fails, is tried once more with this many times the
+# active-set iterations: an active set that fills slowly (paper-04 of HD 120 near 0.18 m needed
+# some 1000) converges, one that cycles fails again and says so
+LAST_TRY_ITER_FACTOR = 5
 # with a preload (``DriveGeometry.preloaded``), an active-set iterate that swings a loaded free mode so
 # far that a pair open before is penetrated by more than this (units of the module m: a quarter
 # of it, beyond the range the linearised tooth rows stand for) is cut back to the first closing
@@ -223,17 +227,28 @@ class LostMotionModel:
         """``solve_level``; if it fails (an active set that cycles), the load halfway from
         ``from_torque`` (the last level's: a torque, or a prescribed ``Twist``) is solved first and
         this one from there, as an FE code cuts back a load step, at most ``cutbacks`` halvings
-        deep.  A failed solve leaves the warm start and the friction state of the last level (it
-        commits them only when it converges), so the retry starts where the failed one did."""
+        deep; the deepest is tried once more with ``LAST_TRY_ITER_FACTOR`` times the active-set
+        iterations.  A failed solve leaves the warm start and the friction state of the last level
+        (it commits them only when it converges), so the retry starts where the failed one did."""
         try:
             return self.solve_level(torque, active)
         except ContactFailure:
             if cutbacks == 0:
-                raise
+                return self._solve_level_longer(torque, active)
             mid = (Twist(0.5 * (from_torque.rad + torque.rad)) if isinstance(torque, Twist)
                    else 0.5 * (from_torque + torque))
             half = self.solve_level_stepped(mid, active, from_torque, cutbacks - 1)
             return self.solve_level_stepped(torque, half.active, mid, cutbacks - 1)
+
+    def _solve_level_longer(self, torque: float | Twist, active: frozenset | None) -> LevelSolution:
+        """``solve_level`` with ``LAST_TRY_ITER_FACTOR`` times the active-set iterations; its
+        failure (naming the larger limit) is raised as it is."""
+        settings = self.solver.settings
+        self.solver.settings = replace(settings, max_iter=LAST_TRY_ITER_FACTOR * settings.max_iter)
+        try:
+            return self.solve_level(torque, active)
+        finally:
+            self.solver.settings = settings
 
     def full_displacements(self, solution: LevelSolution, torque: float) -> dict[str, np.ndarray]:
         """Displacement (2, nnodes) of every body at a solved level, u = K^-1 (f + G^T p) + R alpha
