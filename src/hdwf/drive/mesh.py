@@ -43,6 +43,7 @@ import numpy as np
 from skfem import MeshTri
 
 from hdwf.drive.geometry import DriveGeometry, cs_half_space_angle, fs_half_angle
+from hdwf.drive.gmsh_read import read_surface
 from hdwf.drive.relief import relief_start_depth
 from hdwf.drive.sector_mesh import RingProfile, RingSizes, copy_round, mesh_period
 
@@ -90,8 +91,8 @@ def _sizes(g: DriveGeometry, n_h: int, n_t: int, refinement: float) -> dict[str,
     )
 
 
-def _circle(geo, r: float, size: float, c: int, nseg: int | None = None) -> list[int]:
-    """Full circle as 4 arcs (geo arcs must span < pi), optional transfinite count."""
+def _circle(geo, r: float, size: float, c: int) -> list[int]:
+    """Full circle as 4 arcs (geo arcs must span < pi)."""
     pts = [geo.addPoint(r * math.cos(a), r * math.sin(a), 0.0, size)
            for a in np.arange(4) * math.pi / 2]
     arcs = [geo.addCircleArc(pts[i], c, pts[(i + 1) % 4]) for i in range(4)]
@@ -239,10 +240,8 @@ def _bearing_rings(g: DriveGeometry, s: dict, half: bool, rings: tuple[str, ...]
     gmsh.option.setNumber("Mesh.Algorithm", MESH_ALGORITHM)
     gmsh.option.setNumber("Mesh.LcIntegrationPrecision", LC_INTEGRATION_PRECISION)
     gmsh.model.mesh.generate(2)
-    ntags, coords, _ = gmsh.model.mesh.getNodes()
-    xy = np.zeros((int(ntags.max()) + 1, 2))
-    xy[ntags.astype(np.int64)] = coords.reshape(-1, 3)[:, :2]
-    return {name: _extract_body(name, groups, xy, g.B, list(spec[name][2:])) for name in rings}
+    return {name: _body_of_surface(name, groups[name][1][0], g.B,
+                                   {bn: groups[bn][1] for bn in spec[name][2:]}) for name in rings}
 
 
 def _write_review(path: str, meshes: dict[str, BodyMesh]) -> None:
@@ -267,24 +266,14 @@ def _write_review(path: str, meshes: dict[str, BodyMesh]) -> None:
     gmsh.write(path)
 
 
-def _extract_body(name: str, groups: dict, xy: np.ndarray, thickness: float, boundary_names: list[str]) -> BodyMesh:
-    """One body's triangles (counter-clockwise, local numbering) and its named boundaries."""
-    surf = groups[name][1][0]
-    et, _, enodes = gmsh.model.mesh.getElements(2, surf)
-    tri = np.asarray(enodes[list(et).index(2)], dtype=np.int64).reshape(-1, 3)
-    used = np.unique(tri)
-    loc = -np.ones(xy.shape[0], dtype=np.int64)
-    loc[used] = np.arange(used.size)
-    p = xy[used].T.copy()
-    bm = BodyMesh(name, MeshTri(p, _counter_clockwise(p, loc[tri].T)), thickness)
-    for bn in boundary_names:
-        edges = []
-        for cv in groups[bn][1]:
-            et1, _, en1 = gmsh.model.mesh.getElements(1, cv)
-            edges.append(np.asarray(en1[list(et1).index(1)], dtype=np.int64).reshape(-1, 2))
-        e = loc[np.vstack(edges)]
-        bm.edge_sets[bn] = e
-        bm.node_sets[bn] = np.unique(e)
+def _body_of_surface(name: str, surface: int, thickness: float, boundaries: dict[str, list[int]]) -> BodyMesh:
+    """The body meshed on gmsh surface ``surface`` (triangles counter-clockwise, its own
+    numbering) with its named boundaries (name -> gmsh curves)."""
+    read = read_surface(surface)
+    bm = BodyMesh(name, MeshTri(read.points, _counter_clockwise(read.points, read.triangles)), thickness)
+    for bn, curves in boundaries.items():
+        e = read.curve_edges(curves)
+        bm.edge_sets[bn], bm.node_sets[bn] = e, np.unique(e)
     return bm
 
 
@@ -325,23 +314,6 @@ def annulus_mesh(r_in: float, r_out: float, size: float) -> BodyMesh:
         geo.synchronize()
         gmsh.model.addPhysicalGroup(2, [surf], name="ring")
         gmsh.model.mesh.generate(2)
-        ntags, coords, _ = gmsh.model.mesh.getNodes()
-        xy = np.zeros((int(ntags.max()) + 1, 2))
-        xy[ntags.astype(np.int64)] = coords.reshape(-1, 3)[:, :2]
-        et, _, en = gmsh.model.mesh.getElements(2, surf)
-        tri = np.asarray(en[list(et).index(2)], dtype=np.int64).reshape(-1, 3)
-        used = np.unique(tri)
-        loc = -np.ones(xy.shape[0], dtype=np.int64)
-        loc[used] = np.arange(used.size)
-        p = xy[used].T.copy()
-        bm = BodyMesh("ring", MeshTri(p, _counter_clockwise(p, loc[tri].T)), 1.0)
-        for name, arcs in (("inner", inner), ("outer", outer)):
-            edges = []
-            for cv in arcs:
-                et1, _, en1 = gmsh.model.mesh.getElements(1, cv)
-                edges.append(np.asarray(en1[list(et1).index(1)], dtype=np.int64).reshape(-1, 2))
-            e = loc[np.vstack(edges)]
-            bm.edge_sets[name], bm.node_sets[name] = e, np.unique(e)
+        return _body_of_surface("ring", surf, 1.0, {"inner": inner, "outer": outer})
     finally:
         gmsh.finalize()
-    return bm

@@ -21,6 +21,8 @@ from dataclasses import dataclass
 import gmsh
 import numpy as np
 
+from hdwf.drive.gmsh_read import read_surface
+
 
 @dataclass(frozen=True)
 class RingProfile:
@@ -92,9 +94,11 @@ def mesh_period(prof: RingProfile, sizes: RingSizes, algorithm: int, lc_precisio
     gmsh.option.setNumber("Mesh.Algorithm", algorithm)
     gmsh.option.setNumber("Mesh.LcIntegrationPrecision", lc_precision)
     gmsh.model.mesh.generate(2)
-    p, t, edges_of = _read_period(surf)
+    period = read_surface(surf)
+    p, edges_of = period.points, period.curve_edges
     edges = {prof.outline_group: edges_of(outline), prof.plain_group: edges_of([plain])}
-    return SectorMesh(p, t, edges, _cut_nodes(p, edges_of([cut0])), _cut_nodes(p, edges_of([cut1])))
+    return SectorMesh(p, period.triangles, edges, _cut_nodes(p, edges_of([cut0])),
+                      _cut_nodes(p, edges_of([cut1])))
 
 
 def _rim_size_field(prof: RingProfile, sizes: RingSizes) -> None:
@@ -108,27 +112,6 @@ def _rim_size_field(prof: RingProfile, sizes: RingSizes) -> None:
     gmsh.model.mesh.field.setString(field, "F", (
         f"({sizes.tooth!r}) + ({sizes.plain - sizes.tooth!r}) * Max(0, (Sqrt(x*x + y*y) - ({r_start!r})) / ({depth!r}))"))
     gmsh.model.mesh.field.setAsBackgroundMesh(field)
-
-
-def _read_period(surf: int):
-    """The meshed period's nodes (2, n) and triangles (3, k), local numbering (the arcs' centre
-    point, in no triangle, left out), and a function giving the edges of some curves."""
-    tags, coords, _ = gmsh.model.mesh.getNodes()
-    xy = np.zeros((2, int(tags.max()) + 1))
-    xy[:, tags.astype(np.int64)] = coords.reshape(-1, 3)[:, :2].T
-    et, _, en = gmsh.model.mesh.getElements(2, surf)
-    tri = np.asarray(en[list(et).index(2)], dtype=np.int64).reshape(-1, 3)
-    used = np.unique(tri)
-    loc = -np.ones(xy.shape[1], dtype=np.int64)
-    loc[used] = np.arange(used.size)
-
-    def edges_of(curves):
-        out = []
-        for cv in curves:
-            et1, _, en1 = gmsh.model.mesh.getElements(1, abs(cv))
-            out.append(loc[np.asarray(en1[list(et1).index(1)], dtype=np.int64).reshape(-1, 2)])
-        return np.vstack(out)
-    return xy[:, used].copy(), loc[tri].T.copy(), edges_of
 
 
 def _cut_nodes(p: np.ndarray, edges: np.ndarray) -> np.ndarray:

@@ -375,7 +375,7 @@ def anchored_responses(resolver: Resolver, t_hat: dict[str, float]) -> dict[str,
     for e, (ts, variants) in plan.items():
         S = np.array([predict(tab, resolver.obs, variant_key(v)) for v in variants])
         if not np.isfinite(S).all():
-            bad = tab.loc[tab["status"] != "ok"].drop_duplicates("specimen_id")
+            bad = tab.loc[tab["status"] != "ok"]
             out[e] = "the solve failed" + (
                 f" ({bad['specimen_id'].iloc[0]}, {bad['variant'].iloc[0]}: {bad['status'].iloc[0]})"
                 if len(bad) else "")
