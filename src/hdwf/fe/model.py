@@ -30,8 +30,7 @@ from hdwf.fe.working_set import WorkingSet
 ZONE_DEG = 35.0   # half width (deg) of the tooth zones about the major axes solved by default
 LEVEL_CUTBACKS = 2   # a load level that does not converge is reached in up to 2 halvings of its step
 # ... and the deepest of them, if it still fails, is tried once more with this many times the
-# active-set iterations: an active set that fills slowly (paper-04 of HD 120 near 0.18 m needed
-# some 1000) converges, one that cycles fails again and says so
+# active-set iterations: an active set that fills slowly converges, one that cycles fails again
 LAST_TRY_ITER_FACTOR = 5
 # with a preload (``DriveGeometry.preloaded``), an active-set iterate that swings a loaded free mode so
 # far that a pair open before is penetrated by more than this (units of the module m: a quarter
