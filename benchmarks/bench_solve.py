@@ -5,12 +5,9 @@ Options: a positional refinement (default 1.0), ``--symmetry full|half`` (defaul
 the half model uses the drive's 180 deg point symmetry), ``--unit hd42|hd120`` (HD 120
 Table 5 set 8), ``--repeats N``, ``--preload DELTA`` (a preloaded engagement alone,
 ``interference_m`` = DELTA with its tip relief, every tooth watched) and ``--studies-model``
-(the effects of ``config.yaml``'s ``fe.effects``, the model of the ``fe`` and ``fe_at_paper`` studies);
-the allocator keeps freed memory as the workflow's jobs do (``hdwf.common.allocator``), or not
-with ``--glibc-default``.
+(the effects of ``config.yaml``'s ``fe.effects``, the model of the ``fe`` and ``fe_at_paper`` studies).
 Prints mesh time, solve_s, factorize_s (one factorisation of every body's stiffness),
-their ratio, Phi, the peak resident memory of the process and the median page faults and
-system time of a solve (resource.getrusage).
+their ratio, Phi and the peak resident memory of the process (resource.getrusage).
 """
 
 from __future__ import annotations
@@ -23,7 +20,6 @@ import time
 
 import _one_thread  # noqa: F401,E402  (first: one BLAS thread, hdwf importable)
 
-from hdwf.common.allocator import keep_freed_memory  # noqa: E402
 from hdwf.config import load_config  # noqa: E402
 from hdwf.fe import solve_lost_motion  # noqa: E402
 from hdwf.drive.geometry import drive_geometry  # noqa: E402
@@ -41,9 +37,7 @@ DESIGNS = {
 
 
 def main(repeats: int = 3, refinement: float = 1.0, symmetry: str = "full",
-         unit: str = "hd42", preload: float = 0.0, studies_model: bool = False,
-         keep_memory: bool = True) -> None:
-    kept = keep_freed_memory() if keep_memory else False
+         unit: str = "hd42", preload: float = 0.0, studies_model: bool = False) -> None:
     args, label = DESIGNS[unit]
     if studies_model:
         effects = load_config(ROOT / "config.yaml")["fe"]["effects"]
@@ -56,17 +50,13 @@ def main(repeats: int = 3, refinement: float = 1.0, symmetry: str = "full",
     t0 = time.perf_counter()
     mesh = build_mesh(g, refinement=refinement, symmetry=symmetry)
     mesh_s = time.perf_counter() - t0
-    runs, faults, system_s = [], [], []
+    runs = []
     for _ in range(repeats):
-        before = resource.getrusage(resource.RUSAGE_SELF)
         r = solve_lost_motion(g, mesh, steps_per_ramp=5, changes=changes)
-        after = resource.getrusage(resource.RUSAGE_SELF)
         if r.status != "ok":
             print(f"FAILED: {r.reason}")
             sys.exit(1)
         runs.append(r)
-        faults.append(after.ru_minflt - before.ru_minflt)
-        system_s.append(after.ru_stime - before.ru_stime)
     solve = statistics.median(r.solve_s for r in runs)
     fact = statistics.median(r.factorize_s for r in runs)
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
@@ -78,8 +68,6 @@ def main(repeats: int = 3, refinement: float = 1.0, symmetry: str = "full",
     print(f"factorize_s       {fact:.2f}")
     print(f"ratio             {solve / fact:.1f}")
     print(f"peak memory       {peak_mb:.0f} MB")
-    print(f"page faults       {statistics.median(faults):.0f} per solve (median), system time "
-          f"{statistics.median(system_s):.2f} s; freed memory kept: {kept}")
     print(f"Phi               {r.lost_motion_arcmin:.4f} arcmin (phi {r.phi_plus_arcmin:.4f}, "
           f"phi' {r.phi_minus_arcmin:.4f})")
     print(f"teeth in contact  {r.teeth_in_contact}, max penetration "
@@ -95,8 +83,6 @@ if __name__ == "__main__":
     model = ap.add_mutually_exclusive_group()
     model.add_argument("--preload", type=float, default=0.0, help="interference_m of the preload (0: bare)")
     model.add_argument("--studies-model", action="store_true", help="config.yaml's fe.effects")
-    ap.add_argument("--glibc-default", action="store_true",
-                    help="leave glibc's allocator as it is (the jobs keep freed memory)")
     a = ap.parse_args()
     main(repeats=a.repeats, refinement=a.refinement, symmetry=a.symmetry, unit=a.unit, preload=a.preload,
-         studies_model=a.studies_model, keep_memory=not a.glibc_default)
+         studies_model=a.studies_model)

@@ -10,7 +10,6 @@ import sys
 from pathlib import Path
 
 from hdwf import __version__
-from hdwf.common.allocator import keep_freed_memory
 from hdwf.common.errors import InputError
 from hdwf.common.io import atomic_path
 from hdwf.common.provenance import config_hash, provenance
@@ -239,7 +238,6 @@ def main(argv=None) -> int:
     _solve_options(p, 5, 3)                  # the campaigns' coarse mesh
     p.set_defaults(func=_plan)
     args = parser.parse_args(argv)
-    keep_freed_memory()          # synth and plan solve designs as the workflow's jobs do
     try:
         return args.func(args)
     except InputError as exc:

@@ -5,22 +5,19 @@ import logging
 import os
 from pathlib import Path
 
-from hdwf.common.allocator import keep_freed_memory
 from hdwf.common.provenance import provenance
 
 PROJECT_ROOT = Path(__file__).resolve().parents[2]
 
 
 def setup(snakemake):
-    """Log to the rule's log file, keep freed memory for reuse (``hdwf.common.allocator``);
-    return the provenance stamped on every artefact.
+    """Log to the rule's log file; return the provenance stamped on every artefact.
 
     The git commit is read from the checkout this script lives in, found from the script's own
     path, so no rule passes an absolute path as a parameter (a moved project plans no reruns).
     """
     logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, force=True,
                         format="%(asctime)s %(levelname)s %(message)s")
-    logging.info("freed memory kept for reuse (glibc mallopt): %s", keep_freed_memory())
     return provenance(snakemake.config, PROJECT_ROOT)
 
 
