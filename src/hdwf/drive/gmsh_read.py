@@ -33,7 +33,7 @@ class SurfaceMesh:
 
 def read_surface(surface: int) -> SurfaceMesh:
     """Surface ``surface`` of gmsh's current (meshed) model as a ``SurfaceMesh``."""
-    tags, coords, _ = gmsh.model.mesh.getNodes()
+    tags, coords, _ = gmsh.model.mesh.getNodes(2, surface, includeBoundary=True)   # its own nodes only
     xy = np.zeros((2, int(tags.max()) + 1))
     xy[:, tags.astype(np.int64)] = coords.reshape(-1, 3)[:, :2].T
     tri = _elements(2, surface, 2, 3)
