@@ -13,6 +13,7 @@ import pytest
 from hdwf.drive.geometry import ARCMIN, drive_geometry, geometric_backlash_arcmin
 from hdwf.drive.mesh import DriveMesh, build_mesh, share_bodies
 from hdwf.fe import LostMotionModel, ModelChanges, solve_lost_motion
+from hdwf.fe.solver import TOL_GAP
 
 COARSE = dict(elements_over_height=6, elements_over_thickness=4, refinement=1.0)
 
@@ -133,8 +134,11 @@ def test_hd120_phi_at_least_the_rigid_backlash():
 @pytest.mark.parametrize("symmetry", [pytest.param("full", marks=pytest.mark.slow), "half"])
 def test_full_fields_reproduce_the_contact_solution(monkeypatch, symmetry):
     """The displacement fields rebuilt for pictures (u = K^-1 (f + G^T p) + R alpha on every
-    node) must equal the contact solution on the watched dofs to round-off, at the mounted
-    wave generator and at +T."""
+    node, one back-substitution a body) must equal the contact solution on the watched dofs,
+    at the mounted wave generator and at +T, far below the gap tolerance it is solved to:
+    within 1e-3 TOL_GAP (10 pm).  Not to round-off: the contact solution's FS columns are turned
+    from one tooth period's (``RingColumns``), which match a back-substitution to ~1e-8 of
+    their size (3 pm measured here)."""
     diffs = []
     original = LostMotionModel.full_displacements
 
@@ -155,7 +159,7 @@ def test_full_fields_reproduce_the_contact_solution(monkeypatch, symmetry):
     assert r.status == "ok", r.reason
     # wg, the check of the teeth outside the zones at the mount, plus
     assert set(r.fields) == {"wg", "plus"} and len(diffs) == 3
-    assert max(diffs) < 1e-9  # mm
+    assert max(diffs) < 1e-3 * TOL_GAP  # mm
     # the mounted wave generator pushes the FS out at the major axis by about w0 = m
     assert r.wg_deflection_um > 0.5 * g.w0 * 1000
 
@@ -294,7 +298,6 @@ def test_models_of_two_allowances_share_the_cs_and_rings_and_solve_as_alone():
     a housing is not taken."""
     from hdwf.fe.cycle import solve_lost_motion_variants
     from hdwf.fe.model import SharedBodies
-    from hdwf.fe.solver import TOL_GAP
     from hdwf.study.convergence import twist_resolution_arcmin
 
     args = ("hd42", 31.0, 42.0, 0.015, 0.005, 0.005)

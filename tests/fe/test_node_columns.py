@@ -12,10 +12,15 @@ from hdwf.fe.bodies import Body
 
 
 @lru_cache(maxsize=None)
-def _structure():
+def _structure(symmetry="half", rings=False):
+    """A coarse HD 42 structure; with ``rings`` False its tooth bodies keep plain
+    ``NodeColumns`` (no turns by periods)."""
     g = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.005, 0.005)
-    mesh = build_mesh(g, elements_over_height=6, elements_over_thickness=4, symmetry="half")
-    return LostMotionModel(g, mesh).structure
+    mesh = build_mesh(g, elements_over_height=6, elements_over_thickness=4, symmetry=symmetry)
+    structure = LostMotionModel(g, mesh).structure
+    if not rings:
+        structure.plain_node_columns()
+    return structure
 
 
 def _direct(structure, G):

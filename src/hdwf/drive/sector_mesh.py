@@ -143,6 +143,11 @@ def copy_round(sector: SectorMesh, z: int, half: bool) -> tuple[np.ndarray, np.n
     p = np.empty((2, used.size))
     base = sector.p.copy()
     base[1, c0] = 0.0                  # the cut at angle 0 lies on the x axis
+    # and the second cut is its exact image (gmsh's periodic copy is off by ~1e-12 mm), so the
+    # ring is periodic to round-off: its stiffness then commutes with the turn by a period
+    # closely enough for the FS's columns to be turned (``hdwf.fe.ring_columns``)
+    base[:, c1] = np.array([[math.cos(alpha), -math.sin(alpha)],
+                            [math.sin(alpha), math.cos(alpha)]]) @ base[:, c0]
     for k in range(copies - 1, -1, -1):    # copy 0 last: the merged nodes keep exact positions
         a = k * alpha
         rot = np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])

@@ -17,6 +17,8 @@ Phi = phi + phi'.  The modules, from the bottom up:
 * ``column_store``, ``node_columns``, ``working_set`` and ``friction``: compliance columns kept
   in chunks a fork shares, the responses kept per tooth node, the cached compliance of the
   working set, and the flank law (frictionless or Coulomb) with its own cache and stick/slip state;
+* ``ring_columns``: the FS's and CS's columns turned from one tooth period's (their stiffness
+  commutes with the turn by a period), so only the first periods' loads are back-substituted;
 * ``solver``: the active-set contact solver of one load level, at a torque or a prescribed twist;
 * ``relinearise``: the tooth and cam rows re-detected at a solved state until they agree;
 * ``model``: ``LostMotionModel``, which assembles the pieces for one design;

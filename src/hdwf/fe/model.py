@@ -131,7 +131,8 @@ class LostMotionModel:
                                           half=self.half)
             self.factorize_s += seconds
             bodies[name] = body
-        self.structure = Structure(bodies, self.half, geom.r_fs_root)
+        self.structure = Structure(bodies, self.half, geom.r_fs_root,
+                                   {"fs": geom.z_fs, "cs": geom.z_cs})
         for name, columns in taken.items():
             if columns is not None:
                 self.structure.adopt_node_columns(name, columns)

@@ -60,37 +60,9 @@ class NodeColumns:
 
     def plan(self, nodes: tuple[int, ...], load: np.ndarray,
              pending: list[tuple[np.ndarray, np.ndarray]]) -> list[tuple[int, float]]:
-        """(response index, weight) pairs whose sum is the response to ``load``.
-
-        ``load`` holds the x and y components on each of ``nodes`` (sorted).  Its part outside
-        the span of the known patterns on ``nodes`` and on each single one of them becomes a new
-        pattern, queued in ``pending`` (watch dofs, values) for back-substitution.
-        """
-        subsets = [nodes] if len(nodes) == 1 else [(n,) for n in nodes] + [nodes]
-        basis, index = [], []
-        for sub in subsets:
-            where = [2 * nodes.index(n) + k for n in sub for k in (0, 1)]
-            for vec, j in self.patterns.get(sub, ()):
-                col = np.zeros(load.size)
-                col[where] = vec
-                basis.append(col)
-                index.append(j)
-        size = float(np.linalg.norm(load))
-        coef: list[tuple[int, float]] = []
-        rest = load
-        if basis:
-            A = np.array(basis).T
-            c = np.linalg.lstsq(A, load, rcond=None)[0]
-            coef = list(zip(index, c.tolist()))
-            rest = load - A @ c
-        rest_size = float(np.linalg.norm(rest))
-        if rest_size > SPAN_TOL * size:
-            j = self.size + len(pending)
-            self.patterns.setdefault(nodes, []).append((rest / rest_size, j))
-            dofs = np.array([2 * n + k for n in nodes for k in (0, 1)])
-            pending.append((dofs, rest / rest_size))
-            coef.append((j, rest_size))
-        return coef
+        """(response index, weight) pairs whose sum is the response to ``load``
+        (``plan_patterns`` on this body's patterns)."""
+        return plan_patterns(self.patterns, self.size, nodes, load, pending)
 
     def add(self, U_watch: np.ndarray, twist: np.ndarray) -> None:
         """Store the responses (n_watch_dofs x k) of the pending loads, in their order."""
@@ -104,18 +76,8 @@ class NodeColumns:
         Returns the indices of those columns, their responses and twists, and the indices of
         the columns left to back-substitute whole.
         """
-        k = G_body.shape[1]
-        n_nodes = G_body.shape[0] // 2
-        col = np.repeat(np.arange(k), np.diff(G_body.indptr))
-        key, inv = np.unique(col * n_nodes + G_body.indices // 2, return_inverse=True)
-        pieces = np.zeros((key.size, 2))
-        np.add.at(pieces, (inv, G_body.indices % 2), G_body.data)
-        piece_col, piece_node = key // n_nodes, key % n_nodes
-        nonzero = pieces.any(axis=1)
-        piece_col, piece_node, pieces = piece_col[nonzero], piece_node[nonzero], pieces[nonzero]
-        nodes_per_col = np.bincount(piece_col, minlength=k)
+        piece_node, pieces, nodes_per_col, start = row_pieces(G_body)
         built = np.flatnonzero((nodes_per_col > 0) & (nodes_per_col <= MAX_PATTERN_NODES))
-        start = np.concatenate([[0], np.cumsum(nodes_per_col)])
         pending: list[tuple[np.ndarray, np.ndarray]] = []
         r, c, v = [], [], []
         for j, col_k in enumerate(built.tolist()):
@@ -135,3 +97,59 @@ class NodeColumns:
         basis."""
         both = self._store.right_multiply(C)
         return both[:-1], both[-1]
+
+
+def row_pieces(G_body: sp.csc_matrix) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The loads of the rows (columns of ``G_body``, the body's watch dofs x k) node by node.
+
+    Returns the watch node of every piece, its x and y load (pieces x 2), the nodes of every
+    row and where each row's pieces start (k + 1; the pieces are in row order, nodes sorted).
+    """
+    k = G_body.shape[1]
+    n_nodes = G_body.shape[0] // 2
+    col = np.repeat(np.arange(k), np.diff(G_body.indptr))
+    key, inv = np.unique(col * n_nodes + G_body.indices // 2, return_inverse=True)
+    pieces = np.zeros((key.size, 2))
+    np.add.at(pieces, (inv, G_body.indices % 2), G_body.data)
+    piece_col, piece_node = key // n_nodes, key % n_nodes
+    nonzero = pieces.any(axis=1)
+    piece_col, piece_node, pieces = piece_col[nonzero], piece_node[nonzero], pieces[nonzero]
+    nodes_per_col = np.bincount(piece_col, minlength=k)
+    return piece_node, pieces, nodes_per_col, np.concatenate([[0], np.cumsum(nodes_per_col)])
+
+
+def plan_patterns(patterns: dict[tuple[int, ...], list[tuple[np.ndarray, int]]], size: int,
+                  nodes: tuple[int, ...], load: np.ndarray,
+                  pending: list[tuple[np.ndarray, np.ndarray]]) -> list[tuple[int, float]]:
+    """(response index, weight) pairs whose sum is the response to ``load``.
+
+    ``load`` holds the x and y components on each of ``nodes`` (sorted).  Its part outside
+    the span of the known ``patterns`` on ``nodes`` and on each single one of them becomes a
+    new pattern (index ``size`` + its place in ``pending``), queued in ``pending`` as (dofs
+    2 node + component, values) for back-substitution.
+    """
+    subsets = [nodes] if len(nodes) == 1 else [(n,) for n in nodes] + [nodes]
+    basis, index = [], []
+    for sub in subsets:
+        where = [2 * nodes.index(n) + k for n in sub for k in (0, 1)]
+        for vec, j in patterns.get(sub, ()):
+            col = np.zeros(load.size)
+            col[where] = vec
+            basis.append(col)
+            index.append(j)
+    norm = float(np.linalg.norm(load))
+    coef: list[tuple[int, float]] = []
+    rest = load
+    if basis:
+        A = np.array(basis).T
+        c = np.linalg.lstsq(A, load, rcond=None)[0]
+        coef = list(zip(index, c.tolist()))
+        rest = load - A @ c
+    rest_size = float(np.linalg.norm(rest))
+    if rest_size > SPAN_TOL * norm:
+        j = size + len(pending)
+        patterns.setdefault(nodes, []).append((rest / rest_size, j))
+        dofs = np.array([2 * n + k for n in nodes for k in (0, 1)])
+        pending.append((dofs, rest / rest_size))
+        coef.append((j, rest_size))
+    return coef

@@ -25,6 +25,9 @@ import scipy.sparse as sp
 
 from hdwf.fe.bodies import Body
 from hdwf.fe.node_columns import PATTERN_BODIES, NodeColumns
+from hdwf.fe.ring_columns import RingColumns
+
+ToothColumns = NodeColumns | RingColumns
 
 ModeName = tuple[str, str]      # (body, mode), e.g. ("fs", "rot")
 
@@ -83,14 +86,19 @@ class Structure:
         Half model (the rim carries half the torque).
     r_rim : float
         Radius (mm) below which FS triangles belong to the loaded rim (the tooth roots).
+    teeth : dict[str, int], optional
+        Tooth counts of the ring bodies (``fs``, ``cs``): their node responses are then turned
+        from one period's (``RingColumns``) where the body checks out as such a ring.
     """
 
-    def __init__(self, bodies: dict[str, Body], half: bool, r_rim: float):
+    def __init__(self, bodies: dict[str, Body], half: bool, r_rim: float,
+                 teeth: dict[str, int] | None = None):
         self.bodies = bodies
         self.half = half
         self.f_scale = 0.5 if half else 1.0
         self.nwatch = _number_watch_dofs(bodies)
-        self._node_cache: dict[str, NodeColumns] = {}    # shared by copies with the same body
+        self.teeth = dict(teeth or {})
+        self._node_cache: dict[str, ToothColumns] = {}    # shared by copies with the same body
         self.n_dofs = sum(b.stiffness.shape[0] for b in bodies.values())
         fs = bodies["fs"]
         # load per unit torque is f_scale * twist_measure (N/(N mm))
@@ -158,16 +166,26 @@ class Structure:
                 Xq[cc] += Xwq
         return X, Xq
 
-    def _node_columns(self, name: str, body: Body) -> NodeColumns:
+    def _node_columns(self, name: str, body: Body) -> ToothColumns:
         if name not in self._node_cache:
-            self._node_cache[name] = NodeColumns(2 * body.watch_nodes.size)
+            ring = None
+            if name in self.teeth:
+                twist_response = self.unit_torque_u / self.f_scale if name == "fs" else None
+                ring = RingColumns.for_body(body, self.teeth[name], self.half, twist_response)
+            self._node_cache[name] = ring if ring is not None else NodeColumns(2 * body.watch_nodes.size)
         return self._node_cache[name]
 
-    def node_columns(self, name: str) -> NodeColumns:
+    def plain_node_columns(self) -> None:
+        """From now on, plain ``NodeColumns`` for every body (no turns by periods): the
+        reference that ``RingColumns`` is checked against, and the fallback."""
+        self.teeth = {}
+        self._node_cache = {}
+
+    def node_columns(self, name: str) -> ToothColumns:
         """The responses kept for loads on the nodes of body ``name``."""
         return self._node_columns(name, self.bodies[name])
 
-    def adopt_node_columns(self, name: str, columns: NodeColumns) -> None:
+    def adopt_node_columns(self, name: str, columns: ToothColumns) -> None:
         """Keep the node responses of body ``name`` in ``columns``, those of another structure
         with the same body (same factorisation and watch nodes): they are on the body's own
         watch dofs, whatever its place in either watch vector."""
