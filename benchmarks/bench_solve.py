@@ -5,7 +5,9 @@ Options: a positional refinement (default 1.0), ``--symmetry full|half`` (defaul
 the half model uses the drive's 180 deg point symmetry), ``--unit hd42|hd120`` (HD 120
 Table 5 set 8), ``--repeats N``, ``--preload DELTA`` (a preloaded engagement alone,
 ``interference_m`` = DELTA with its tip relief, every tooth watched) and ``--studies-model``
-(the effects of ``config.yaml``'s ``fe.effects``, the model of the ``fe`` and ``fe_at_paper`` studies).
+(the effects of ``config.yaml``'s ``fe.effects``, the model of the ``fe`` and ``fe_at_paper`` studies);
+``--plain-columns`` back-substitutes the FS's and CS's columns node set by node set, not turned
+from one tooth period's (``hdwf.fe.ring_columns``), for comparison.
 Prints mesh time, solve_s, factorize_s (one factorisation of every body's stiffness),
 their ratio, Phi and the peak resident memory of the process (resource.getrusage).
 """
@@ -83,6 +85,11 @@ if __name__ == "__main__":
     model = ap.add_mutually_exclusive_group()
     model.add_argument("--preload", type=float, default=0.0, help="interference_m of the preload (0: bare)")
     model.add_argument("--studies-model", action="store_true", help="config.yaml's fe.effects")
+    ap.add_argument("--plain-columns", action="store_true",
+                    help="no columns turned from one period (hdwf.fe.ring_columns), for comparison")
     a = ap.parse_args()
+    if a.plain_columns:
+        from hdwf.fe.ring_columns import RingColumns
+        RingColumns.for_body = classmethod(lambda cls, *args, **kw: None)
     main(repeats=a.repeats, refinement=a.refinement, symmetry=a.symmetry, unit=a.unit, preload=a.preload,
          studies_model=a.studies_model)
