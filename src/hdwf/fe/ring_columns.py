@@ -135,7 +135,6 @@ class RingColumns:
         self._responses = np.zeros((nd.size, 0))
         self._size = 0
         self.patterns: dict[tuple[int, ...], list[tuple[np.ndarray, int]]] = {}
-        self._watch_src: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         names = sorted(body.modes)
         self._R = np.array([body.modes[m] for m in names]).T if names else np.zeros((nd.size, 0))
         weight = np.ones(nd.shape[1])
@@ -150,7 +149,7 @@ class RingColumns:
             WR = self._w[:, None] * self._R
             self._RWR_inv = np.linalg.inv(self._R.T @ WR)
             self._X = body.solve(WR)
-            self._ER_inv_Et = np.linalg.inv(self._R[self._pinned])     # (E^T R)^-1
+            self._ER_inv = np.linalg.inv(self._R[self._pinned])     # (E^T R)^-1
 
     @classmethod
     def for_body(cls, body: Body, teeth: int, half: bool,
@@ -205,11 +204,11 @@ class RingColumns:
         sg = sgn.reshape((-1,) + (1,) * (ux.ndim - 1))
         return np.stack([sg * (c * ux - s * uy), sg * (s * ux + c * uy)])
 
-    def _pinned_correction(self, turned_at_pins: np.ndarray, F_turned: np.ndarray
+    def _pinned_correction(self, at_pins: np.ndarray, modes_load: np.ndarray
                            ) -> tuple[np.ndarray, np.ndarray]:
-        """Coefficients of X and of R that make G's response A's: c(f) and -(E^T R)^-1 (G f)_E."""
-        c = self._RWR_inv @ (self._R.T @ F_turned)
-        return c, -self._ER_inv_Et @ turned_at_pins
+        """Coefficients of X and of R that make G's response A's, from (G f)_E and R^T f:
+        c(f) = (R^T W R)^-1 R^T f and -(E^T R)^-1 (G f)_E."""
+        return self._RWR_inv @ modes_load, -self._ER_inv @ at_pins
 
     def _checks(self) -> bool:
         """The turned response of a test load is its back-substitution."""
@@ -232,14 +231,14 @@ class RingColumns:
         via = np.zeros_like(direct)
         via[b.dofs[0]], via[b.dofs[1]] = U
         if self._R.shape[1]:
-            c, g = self._pinned_correction(via[self._pinned], F_turned[:, 0])
+            c, g = self._pinned_correction(via[self._pinned], self._R.T @ F_turned[:, 0])
             via = via + self._X @ c + self._R @ g
         ok = np.abs(via - direct).max() <= CHECK_TOL * np.abs(direct).max()
         return bool(ok)
 
     # ------------------------------------------------------------------ the columns
 
-    def columns(self, G_body: sp.csc_matrix, solve=None, batch: int = 16
+    def columns(self, G_body: sp.csc_matrix, solve: object = None, batch: int = 16
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """As ``NodeColumns.columns``: the rows on at most ``MAX_PATTERN_NODES`` nodes (their
         indices, responses on the body's watch dofs and twists) and the rows left to
@@ -322,8 +321,7 @@ class RingColumns:
             Rt = np.zeros((self._R.shape[1], len(coefs)))
             for j, (dofs, vals) in enumerate(zip(loads_dofs, loads_vals)):
                 Rt[:, j] = self._R[dofs].T @ vals
-            c = self._RWR_inv @ Rt
-            g = -self._ER_inv_Et @ pins_val
+            c, g = self._pinned_correction(pins_val, Rt)
             watch_rows = np.stack([nd[0, wn], nd[1, wn]], axis=1).ravel()
             Uw += self._X[watch_rows] @ c + self._R[watch_rows] @ g
         return Uw, twist
