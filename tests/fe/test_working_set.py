@@ -64,6 +64,40 @@ def test_projected_columns_give_the_gaps_of_the_displacement_as_the_set_grows_an
     check(np.array([3, 4, 12]))
 
 
+def test_compliance_among_the_pairs_is_exactly_symmetric_as_it_grows_and_is_refreshed():
+    """The solver cuts its active blocks from ``WorkingSet.compliance`` without symmetrising
+    them, for a Cholesky factor: the columns are made slightly unsymmetric (1e-9 of C, as
+    back-substituted columns are to round-off) and the kept matrix must still be symmetric to
+    the last bit, and G C G^T of the symmetric C to the size of that perturbation."""
+    rng = np.random.default_rng(11)
+    structure = _Structure(rng)
+    skew = rng.standard_normal((NWATCH, NWATCH))
+    C_sym = structure.compliance
+    C_unsym = C_sym + 1e-9 * np.abs(C_sym).max() * (skew - skew.T)
+    structure.compliance_columns = lambda Gr: (C_unsym @ Gr.toarray().T,
+                                               structure.twist @ C_unsym @ Gr.toarray().T)
+    G = _rows(rng)
+    rows = {"tooth": SimpleNamespace(G=G)}
+    ws = WorkingSet(NWATCH)
+
+    def check():
+        Gw = ws.normal_rows.toarray()
+        reference = Gw @ C_sym @ Gw.T
+        assert np.array_equal(ws.compliance, ws.compliance.T)
+        np.testing.assert_allclose(ws.compliance, reference, rtol=0, atol=1e-7 * np.abs(reference).max())
+
+    ws.add(structure, rows, [("tooth", i) for i in range(6)])
+    check()
+    ws.add(structure, rows, [("tooth", i) for i in range(6, 15)])
+    check()
+    moved = G.tolil()
+    moved[3, :] = 0.0
+    moved[3, 11] = 2.5
+    rows["tooth"] = SimpleNamespace(G=moved.tocsr())
+    assert ws.refresh(structure, rows, "tooth") is not None
+    check()
+
+
 @pytest.mark.slow
 def test_solver_gaps_are_those_of_its_displacement_and_a_fork_solves_alike():
     """On a preloaded coarse HD 42 section at the test torque (every tooth pair a candidate,

@@ -74,7 +74,8 @@ def frictionless_kkt(block: ActiveBlock) -> KktSystem:
     """
     nA, nm = len(block.pairs), block.mode_rows.shape[1]
     M = np.zeros((nA + nm, nA + nm))
-    M[:nA, :nA] = block.compliance + 1e-13 * block.scale * np.eye(nA)
+    M[:nA, :nA] = block.compliance
+    M[np.arange(nA), np.arange(nA)] += 1e-13 * block.scale
     M[:nA, nA:] = block.mode_rows
     M[nA:, :nA] = block.mode_rows.T
     return KktSystem(M, np.concatenate([block.gap_rhs, block.mode_rhs]), 0)

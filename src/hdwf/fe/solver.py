@@ -413,8 +413,8 @@ class ContactSolver:
         Al = sorted(A, key=lambda i: ws.position[i])
         wp = np.array([ws.position[i] for i in Al], dtype=np.int64)
         rows = np.array([problem.id_position[i] for i in Al], dtype=np.int64)
-        C = ws.compliance[np.ix_(wp, wp)]
-        C = 0.5 * (C + C.T) + np.diag(sdiag[rows])
+        C = ws.compliance.take(wp, axis=0).take(wp, axis=1)   # (symmetric: ``WorkingSet``)
+        C[np.diag_indices_from(C)] += sdiag[rows]
         T = problem.torque
         return ActiveBlock(
             torque=T, pairs=Al, positions=wp, rows=rows, compliance=C,

@@ -50,7 +50,7 @@ class WorkingSet:
         self.store = ColumnStore(nwatch)            # K^-1 G^T on the watch dofs, by position
         self.twist_columns = np.zeros(0)            # q^T K^-1 G^T
         self.normal_rows: sp.csr_matrix | None = None   # G of the pairs, by position
-        self.compliance = np.zeros((0, 0))          # G K^-1 G^T among the pairs
+        self.compliance = np.zeros((0, 0))          # G K^-1 G^T among the pairs, exactly symmetric
         self.generation = 0                         # counts refreshes: cached projections are stale
 
     def copy(self) -> "WorkingSet":
@@ -84,8 +84,9 @@ class WorkingSet:
         newcols = np.asarray(self.normal_rows @ X)
         CW = np.zeros((n0 + k, n0 + k))
         CW[:n0, :n0] = self.compliance
-        CW[:, n0:] = newcols
+        CW[:n0, n0:] = newcols[:n0]
         CW[n0:, :n0] = newcols[:n0].T
+        CW[n0:, n0:] = _symmetric(newcols[n0:])
         self.compliance = CW
         return AddedPairs(ids, Gn, n0)
 
@@ -109,9 +110,15 @@ class WorkingSet:
         self.store.replace(pos, X)
         self.twist_columns[pos] = Xq
         self.normal_rows = sp.vstack([rows[k].G[i] for k, i in self.pairs]).tocsr()
-        self.compliance = self.store.project(self.normal_rows)
+        self.compliance = _symmetric(self.store.project(self.normal_rows))
         self.generation += 1
         return RefreshedPairs(kind, pos, row_indices)
+
+
+def _symmetric(C: np.ndarray) -> np.ndarray:
+    """(C + C^T) / 2: G K^-1 G^T is symmetric but its back-substituted columns only to
+    round-off, and the active blocks cut from it are factorised by Cholesky."""
+    return 0.5 * (C + C.T)
 
 
 class ProjectedColumns:
