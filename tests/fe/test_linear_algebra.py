@@ -7,7 +7,15 @@ import scipy.sparse as sp
 
 from hdwf.fe.bodies import factorize_spd, plane_stress_lame
 from hdwf.fe.column_store import CHUNK_ROWS, ColumnStore
-from hdwf.fe.solver import _solve_kkt
+from hdwf.fe.active_factor import ActiveFactor, solve_frictionless_kkt, solve_kkt
+
+
+class _WorkingSet:
+    generation = 0
+
+
+def _factor(n):
+    return lambda C: ActiveFactor().solver(C, np.arange(n), 0.0, _WorkingSet())
 
 
 def _laplacian_2d(n: int) -> sp.csr_matrix:
@@ -62,15 +70,16 @@ def test_frictionless_kkt_by_schur_complement_equals_the_lu_solve(n_modes):
     H = rng.standard_normal((nA, n_modes))
     M = np.block([[C, H], [H.T, -1e-14 * np.eye(n_modes)]])
     rhs = rng.standard_normal(nA + n_modes)
-    assert np.allclose(_solve_kkt(M, rhs, nA), np.linalg.solve(M, rhs), rtol=0, atol=1e-10)
-    assert np.allclose(_solve_kkt(M, rhs, None), np.linalg.solve(M, rhs), rtol=0, atol=1e-10)
+    assert np.allclose(solve_frictionless_kkt(M, rhs, nA, _factor(nA)), np.linalg.solve(M, rhs), rtol=0,
+                       atol=1e-10)
+    assert np.allclose(solve_kkt(M, rhs), np.linalg.solve(M, rhs), rtol=0, atol=1e-10)
 
 
 def test_kkt_with_a_c_that_is_not_positive_definite_falls_back_to_lu():
     C = np.diag([2.0, -1.0, 3.0])          # indefinite: Cholesky fails, LU does not
     M = np.block([[C, np.ones((3, 1))], [np.ones((1, 3)), np.zeros((1, 1))]])
     rhs = np.array([1.0, 2.0, 3.0, 0.5])
-    assert np.allclose(_solve_kkt(M, rhs, 3), np.linalg.solve(M, rhs), atol=1e-12)
+    assert np.allclose(solve_frictionless_kkt(M, rhs, 3, _factor(3)), np.linalg.solve(M, rhs), atol=1e-12)
 
 
 @pytest.mark.parametrize("active", [3, 50])   # a few columns (gathered) and most of them (one pass)

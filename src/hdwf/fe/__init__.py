@@ -19,6 +19,8 @@ Phi = phi + phi'.  The modules, from the bottom up:
   working set, and the flank law (frictionless or Coulomb) with its own cache and stick/slip state;
 * ``ring_columns``: the FS's and CS's columns turned from one tooth period's (their stiffness
   commutes with the turn by a period), so only the first periods' loads are back-substituted;
+* ``active_factor``: the dense KKT solves of an active set, with the Cholesky factor of its
+  compliance kept while only part of its diagonal moves (the layer's and the balls' iteration);
 * ``solver``: the active-set contact solver of one load level, at a torque or a prescribed twist;
 * ``relinearise``: the tooth and cam rows re-detected at a solved state until they agree;
 * ``model``: ``LostMotionModel``, which assembles the pieces for one design;

@@ -33,6 +33,8 @@ FRICTION_MAX_IT = 30     # slip-direction iterations per load level (flank frict
 SLIP_TOL = 1e-7          # mm: a slip below 0.1 nm over a step counts as none
 
 
+KKT_REGULARISATION = 1e-13   # times the block's largest compliance, added to its diagonal
+
 @dataclass(frozen=True)
 class ActiveBlock:
     """The dual system of one active set A (see ``solver``), what a flank law builds on."""
@@ -75,7 +77,7 @@ def frictionless_kkt(block: ActiveBlock) -> KktSystem:
     nA, nm = len(block.pairs), block.mode_rows.shape[1]
     M = np.zeros((nA + nm, nA + nm))
     M[:nA, :nA] = block.compliance
-    M[np.arange(nA), np.arange(nA)] += 1e-13 * block.scale
+    M[np.arange(nA), np.arange(nA)] += KKT_REGULARISATION * block.scale
     M[:nA, nA:] = block.mode_rows
     M[nA:, :nA] = block.mode_rows.T
     return KktSystem(M, np.concatenate([block.gap_rhs, block.mode_rhs]), 0)

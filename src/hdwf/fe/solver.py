@@ -37,17 +37,18 @@ load step.  A level that does not converge raises ``ContactFailure``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.linalg import cho_factor, cho_solve
 
 from hdwf.drive.geometry import ARCMIN
+from hdwf.fe.active_factor import ActiveFactor, BlockSolve, solve_frictionless_kkt, solve_kkt
 from hdwf.fe.contact_rows import PairId, Rows, stack_rows
 from hdwf.fe.flank_layer import LayerEdges, LayerIteration
-from hdwf.fe.friction import (FRICTION_MAX_IT, ActiveBlock, FlankLaw, FrictionLevel, NoFriction,
-                              FrictionlessLevel)
+from hdwf.fe.friction import (FRICTION_MAX_IT, KKT_REGULARISATION, ActiveBlock, FlankLaw, FrictionLevel,
+                              NoFriction, FrictionlessLevel)
 from hdwf.fe.structure import ModeName, RigidModes, Structure
 from hdwf.fe.working_set import ProjectedColumns, WorkingSet
 
@@ -160,11 +161,13 @@ class ContactSolver:
     ball_loads: np.ndarray | None = None
     projected: ProjectedColumns | None = None   # of the last level, kept while its rows stay
     layer_state: tuple[LayerEdges, np.ndarray] | None = None   # the last level's tooth layer and its compliances
+    active_factor: ActiveFactor = field(default_factory=ActiveFactor)   # the frictionless blocks' factors
 
     def copy(self) -> "ContactSolver":
         """An independent copy of the state (working set and friction cache copied)."""
         return replace(self, working_set=self.working_set.copy(), friction=self.friction.copy(),
-                       projected=None if self.projected is None else self.projected.copy())
+                       projected=None if self.projected is None else self.projected.copy(),
+                       active_factor=self.active_factor.copy())
 
     def enter(self, structure: Structure, rows: dict[str, Rows], ids: list[PairId]):
         """Enter pairs into the working set (and the friction cache)."""
@@ -434,7 +437,10 @@ class ContactSolver:
         nA, nS, nm = len(block.pairs), system.n_tangential, block.mode_rows.shape[1]
         M = system.matrix
         M[nA + nS:, nA + nS:] = problem.mode_block     # (``_control``)
-        sol = _solve_kkt(M, system.rhs, nA if isinstance(level, FrictionlessLevel) else None)
+        if isinstance(level, FrictionlessLevel):
+            sol = solve_frictionless_kkt(M, system.rhs, nA, self._factor(block))
+        else:
+            sol = solve_kkt(M, system.rhs)
         pA, alpha = sol[:nA], sol[nA + nS:]
         p_full = np.zeros(block.n_pairs)
         p_full[block.rows] = pA
@@ -453,33 +459,10 @@ class ContactSolver:
                 + self.working_set.store.combine(positions, p_active) + problem.modes.watch @ alpha)
 
 
-def _solve_kkt(M: np.ndarray, rhs: np.ndarray, n_forces: int | None) -> np.ndarray:
-    """M^-1 rhs. A frictionless KKT matrix [[C, H], [H^T, E]] (``n_forces`` rows of C) is solved
-    through the Cholesky factor of its positive definite C and the small Schur complement of
-    the modes, half the work of an LU of M; anything else (friction, a C that is not positive
-    definite) by LU, and a singular M (an unheld mode) by least squares."""
-    if n_forces is not None:
-        try:
-            return _solve_saddle(M, rhs, n_forces)
-        except np.linalg.LinAlgError:
-            pass
-    try:
-        return np.linalg.solve(M, rhs)
-    except np.linalg.LinAlgError:
-        return np.linalg.lstsq(M, rhs, rcond=None)[0]
-
-
-def _solve_saddle(M: np.ndarray, rhs: np.ndarray, n: int) -> np.ndarray:
-    """[[C, H], [H^T, E]] [p; alpha] = [r; s]: p = C^-1 (r - H alpha), (H^T C^-1 H - E) alpha =
-    H^T C^-1 r - s. Raises ``LinAlgError`` when C is not positive definite."""
-    C, H, E = M[:n, :n], M[:n, n:], M[n:, n:]
-    factor = cho_factor(C, check_finite=False)
-    Ci_r = cho_solve(factor, rhs[:n], check_finite=False)
-    if H.shape[1] == 0:
-        return Ci_r
-    Ci_H = cho_solve(factor, H, check_finite=False)
-    alpha = np.linalg.solve(H.T @ Ci_H - E, H.T @ Ci_r - rhs[n:])
-    return np.concatenate([Ci_r - Ci_H @ alpha, alpha])
+    def _factor(self, block: ActiveBlock) -> Callable[[np.ndarray], BlockSolve]:
+        """C -> C^-1 of the block's C, kept across blocks that change only part of its diagonal."""
+        return lambda C: self.active_factor.solver(C, block.positions, KKT_REGULARISATION * block.scale,
+                                                   self.working_set)
 
 
 def _same_rows(A: sp.csr_matrix, B: sp.csr_matrix) -> bool:
