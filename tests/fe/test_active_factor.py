@@ -20,15 +20,16 @@ def _compliance(rng):
 
 
 def _block(compliance, positions, s):
+    """The block without and with the solver's regularisation."""
     C = compliance[np.ix_(positions, positions)].copy()
-    C[np.diag_indices_from(C)] += s[positions] + REG
-    return C
+    C[np.diag_indices_from(C)] += s[positions]
+    return C, C + REG * np.eye(positions.size)
 
 
 def _check(factor, compliance, positions, s, ws, rng):
-    C = _block(compliance, positions, s)
+    bare, C = _block(compliance, positions, s)
     B = rng.standard_normal((positions.size, 3))
-    X = factor.solver(C, positions, REG, ws)(B)
+    X = factor.solver(C, positions, np.diag(bare), ws)(B)
     np.testing.assert_allclose(X, np.linalg.solve(C, B), rtol=0, atol=1e-10 * np.abs(X).max())
 
 
@@ -40,7 +41,7 @@ def test_a_layer_iteration_reuses_the_stable_factor_and_solves_as_a_direct_solve
     rng = np.random.default_rng(3)
     compliance = _compliance(rng)
     s = rng.uniform(0.1, 1.0, N_SET)
-    ws, factor = _WorkingSet(), ActiveFactor()
+    ws, factor = _WorkingSet(), ActiveFactor(min_pairs=0)
     positions = np.sort(rng.choice(N_SET, 80, replace=False))
     moving = positions[rng.choice(positions.size, 25, replace=False)]
     _check(factor, compliance, positions, s, ws, rng)         # new generation: all moved
@@ -64,7 +65,7 @@ def test_a_new_generation_or_another_working_set_is_factorised_anew():
     rng = np.random.default_rng(5)
     compliance = _compliance(rng)
     s = rng.uniform(0.1, 1.0, N_SET)
-    ws, factor = _WorkingSet(), ActiveFactor()
+    ws, factor = _WorkingSet(), ActiveFactor(min_pairs=0)
     positions = np.arange(0, N_SET, 2)
     _check(factor, compliance, positions, s, ws, rng)
     s[positions[:10]] *= 1.3
@@ -80,8 +81,24 @@ def test_a_new_generation_or_another_working_set_is_factorised_anew():
     assert factor.updates == 1
 
 
+def test_a_small_block_is_factorised_directly_and_keeps_nothing():
+    """Below ``MIN_KEPT_PAIRS`` a Cholesky costs less than the kept factor's bookkeeping."""
+    rng = np.random.default_rng(9)
+    compliance = _compliance(rng)
+    s = rng.uniform(0.1, 1.0, N_SET)
+    ws, factor = _WorkingSet(), ActiveFactor()
+    assert factor.min_pairs > N_SET
+    positions = np.arange(N_SET)
+    for _ in range(3):
+        s[:10] *= 1.2
+        _check(factor, compliance, positions, s, ws, rng)
+    assert (factor.factorisations, factor.updates) == (0, 0)
+
+
 def test_a_block_that_is_not_positive_definite_raises():
     """The solver then falls back to an LU of the KKT matrix."""
     C = np.array([[1.0, 2.0], [2.0, 1.0]])
     with pytest.raises(np.linalg.LinAlgError):
-        ActiveFactor().solver(C, np.array([0, 1]), 0.0, _WorkingSet())
+        ActiveFactor().solver(C, np.array([0, 1]), np.diag(C), _WorkingSet())
+    with pytest.raises(np.linalg.LinAlgError):
+        ActiveFactor(min_pairs=0).solver(C, np.array([0, 1]), np.diag(C), _WorkingSet())

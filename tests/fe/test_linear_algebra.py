@@ -15,7 +15,7 @@ class _WorkingSet:
 
 
 def _factor(n):
-    return lambda C: ActiveFactor().solver(C, np.arange(n), 0.0, _WorkingSet())
+    return lambda C: ActiveFactor().solver(C, np.arange(n), np.diag(C), _WorkingSet())
 
 
 def _laplacian_2d(n: int) -> sp.csr_matrix:

@@ -28,9 +28,12 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import cho_solve, cholesky, solve_triangular
+from scipy.linalg import cho_factor, cho_solve, cholesky, solve_triangular
 
 REBUILD_VOLATILE_FRACTION = 0.5   # factorise anew once V holds more of the block than this
+# smaller blocks are factorised directly: below ~400 pairs (the coarse meshes of the validation
+# campaigns) a Cholesky costs less than the bookkeeping of the kept factor
+MIN_KEPT_PAIRS = 400
 
 
 @dataclass
@@ -41,8 +44,10 @@ class _Kept:
     L11: np.ndarray               # lower Cholesky factor of C_PP
     volatile: np.ndarray          # working-set positions with a column of W and a row of S
     W: np.ndarray                 # L11^-1 C_PV (|P| x |V|)
-    S: np.ndarray                 # C_VV - W^T W with the diagonal of when each pair entered
+    S: np.ndarray | None          # C_VV - W^T W with the diagonal of when each pair entered
     volatile_diag: np.ndarray     # that diagonal (without the regularisation)
+    L22: np.ndarray | None = None     # the factorisation's chol(S) (S is formed from it when needed)
+    regularisation: np.ndarray | None = None   # ... and the regularisation S had then
 
 
 class BlockSolve:
@@ -77,12 +82,14 @@ def _cholesky(A: np.ndarray) -> np.ndarray:
 class ActiveFactor:
     """Factors of the active blocks of one solver (see the module docstring).
 
-    ``solver(C, positions, regularisation, working_set)`` returns a ``BlockSolve`` of the block C
-    (its pairs at the ascending working-set ``positions``, in that order; ``regularisation`` the
-    multiple of I in C) and raises ``numpy.linalg.LinAlgError`` when C is not positive definite.
+    ``solver(C, positions, diag, working_set)`` returns a ``BlockSolve`` of the block C (its pairs
+    at the ascending working-set ``positions``, in that order; ``diag`` its diagonal without the
+    regularisation, which is what is compared from block to block) and raises
+    ``numpy.linalg.LinAlgError`` when C is not positive definite.
     """
 
-    def __init__(self):
+    def __init__(self, min_pairs: int = MIN_KEPT_PAIRS):
+        self.min_pairs = min_pairs         # smaller blocks: a direct Cholesky, nothing kept
         self._kept: _Kept | None = None
         self._last_diag = np.zeros(0)      # diag(C) (without regularisation) by position, NaN: unseen
         self._source: tuple[object, int] | None = None   # (working set, generation) of the blocks
@@ -91,16 +98,18 @@ class ActiveFactor:
 
     def copy(self) -> "ActiveFactor":
         """A fresh factor: a forked solver's blocks factorise anew (nothing is shared)."""
-        return ActiveFactor()
+        return ActiveFactor(self.min_pairs)
 
-    def solver(self, C: np.ndarray, positions: np.ndarray, regularisation: float,
-               working_set: object) -> BlockSolve:
-        diag = np.diag(C) - regularisation
+    def solver(self, C: np.ndarray, positions: np.ndarray, diag: np.ndarray,
+               working_set: object) -> Callable[[np.ndarray], np.ndarray]:
+        if positions.size < self.min_pairs:
+            factor = cho_factor(C, lower=True, check_finite=False)
+            return lambda B: cho_solve(factor, B, check_finite=False)
         moved = self._moved(positions, diag, working_set)
         kept = self._kept
         if kept is not None and self._reusable(kept, positions, diag):
             return self._update(kept, C, positions, diag)
-        return self._factorise(C, positions, diag, moved, regularisation)
+        return self._factorise(C, positions, diag, moved)
 
     # ------------------------------------------------------------------ which pairs moved
 
@@ -129,25 +138,29 @@ class ActiveFactor:
 
     # ------------------------------------------------------------------ factor anew
 
-    def _factorise(self, C: np.ndarray, positions: np.ndarray, diag: np.ndarray, moved: np.ndarray,
-                   regularisation: float) -> BlockSolve:
+    def _factorise(self, C: np.ndarray, positions: np.ndarray, diag: np.ndarray,
+                   moved: np.ndarray) -> BlockSolve:
         self.factorisations += 1
         self._kept = None                  # (until this factorisation has succeeded)
         at_p, at_v = np.flatnonzero(~moved), np.flatnonzero(moved)
-        L11 = _cholesky(C[np.ix_(at_p, at_p)])
-        W = (solve_triangular(L11, C[np.ix_(at_p, at_v)], lower=True, check_finite=False)
-             if at_p.size else np.zeros((0, at_v.size)))
-        S = C[np.ix_(at_v, at_v)] - W.T @ W
-        L22 = _cholesky(S)
-        if at_p.size:                      # a block that moved everywhere has nothing to keep
-            self._kept = _Kept(positions[at_p], diag[at_p], L11, positions[at_v], W,
-                               S - regularisation * np.eye(at_v.size), diag[at_v])
+        # one Cholesky of C with P first: its leading block is L11, the rows below it W^T, and
+        # the trailing block chol(S)
+        order = np.concatenate([at_p, at_v])
+        L = _cholesky(C.take(order, axis=0).take(order, axis=1))
+        f = at_p.size
+        L11, W, L22 = np.array(L[:f, :f]), np.array(L[f:, :f].T), np.array(L[f:, f:])
+        if f:                              # a block that moved everywhere has nothing to keep
+            self._kept = _Kept(positions[at_p], diag[at_p], L11, positions[at_v], W, None, diag[at_v],
+                               L22, C[at_v, at_v] - diag[at_v])
         return BlockSolve(L11, W, L22, at_p, at_v)
 
     # ------------------------------------------------------------------ reuse the stable factor
 
     def _update(self, kept: _Kept, C: np.ndarray, positions: np.ndarray, diag: np.ndarray) -> BlockSolve:
         self.updates += 1
+        if kept.S is None:                 # the first reuse: S from the factorisation's chol(S)
+            kept.S = kept.L22 @ kept.L22.T - np.diag(kept.regularisation)
+            kept.L22 = kept.regularisation = None
         at_p = np.searchsorted(positions, kept.stable)
         is_stable = np.zeros(positions.size, dtype=bool)
         is_stable[at_p] = True

@@ -190,16 +190,19 @@ class RingColumns:
         U = self.body.solve(F) - self._X @ c
         return U - self._R @ (self._RWR_inv @ (self._R.T @ (self._w[:, None] * U)))
 
-    def _turn(self, U: np.ndarray, p: int, nodes: np.ndarray, cols: np.ndarray | None = None
-              ) -> np.ndarray:
+    def _turn(self, U: np.ndarray, p: int, nodes: np.ndarray, cols: np.ndarray | None = None,
+              right: np.ndarray | None = None) -> np.ndarray:
         """(S_p U) at ``nodes`` (n), x then y: (2, n) or (2, n, k); of U's columns ``cols`` only
-        if given (gathered without copying the rest)."""
+        if given (gathered without copying the rest), times ``right`` if given (the turn acts
+        node by node, so it commutes with combining columns: the fewer combined ones are turned)."""
         src, sgn = self.turns.source(p)[nodes], self.turns.sign(p)[nodes]
         nd = self.body.dofs
         if cols is None:
             ux, uy = U[nd[0, src]], U[nd[1, src]]
         else:
             ux, uy = U[np.ix_(nd[0, src], cols)], U[np.ix_(nd[1, src], cols)]
+        if right is not None:
+            ux, uy = ux @ right, uy @ right
         c, s = self.turns.rotation(p)
         sg = sgn.reshape((-1,) + (1,) * (ux.ndim - 1))
         return np.stack([sg * (c * ux - s * uy), sg * (s * ux + c * uy)])
@@ -307,16 +310,15 @@ class RingColumns:
             for i, w in coef:
                 C[where[i], j] += w
         wn = self.body.watch_nodes
-        turned = self._turn(self._responses, p, wn, used)         # (2, n_watch, used)
+        turned = self._turn(self._responses, p, wn, used, right=C)    # (2, n_watch, k)
         Uw = np.empty((2 * wn.size, len(coefs)))
-        Uw[0::2] = turned[0] @ C
-        Uw[1::2] = turned[1] @ C
+        Uw[0::2], Uw[1::2] = turned[0], turned[1]
         twist = np.zeros(len(coefs))
         if self._twist_response is not None:
             twist = np.array([self._twist_response[d] @ v for d, v in zip(loads_dofs, loads_vals)])
         if self._R.shape[1]:
             nd = self.body.dofs
-            at_pins = self._turn(self._responses, p, self._pin_nodes, used) @ C   # (2, pins, k)
+            at_pins = self._turn(self._responses, p, self._pin_nodes, used, right=C)   # (2, pins, k)
             pins_val = at_pins[self._pin_components, np.arange(self._pinned.size)]
             Rt = np.zeros((self._R.shape[1], len(coefs)))
             for j, (dofs, vals) in enumerate(zip(loads_dofs, loads_vals)):

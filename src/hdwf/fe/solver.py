@@ -47,8 +47,8 @@ from hdwf.drive.geometry import ARCMIN
 from hdwf.fe.active_factor import ActiveFactor, BlockSolve, solve_frictionless_kkt, solve_kkt
 from hdwf.fe.contact_rows import PairId, Rows, stack_rows
 from hdwf.fe.flank_layer import LayerEdges, LayerIteration
-from hdwf.fe.friction import (FRICTION_MAX_IT, KKT_REGULARISATION, ActiveBlock, FlankLaw, FrictionLevel,
-                              NoFriction, FrictionlessLevel)
+from hdwf.fe.friction import (FRICTION_MAX_IT, ActiveBlock, FlankLaw, FrictionLevel, NoFriction,
+                              FrictionlessLevel)
 from hdwf.fe.structure import ModeName, RigidModes, Structure
 from hdwf.fe.working_set import ProjectedColumns, WorkingSet
 
@@ -461,7 +461,7 @@ class ContactSolver:
 
     def _factor(self, block: ActiveBlock) -> Callable[[np.ndarray], BlockSolve]:
         """C -> C^-1 of the block's C, kept across blocks that change only part of its diagonal."""
-        return lambda C: self.active_factor.solver(C, block.positions, KKT_REGULARISATION * block.scale,
+        return lambda C: self.active_factor.solver(C, block.positions, np.diag(block.compliance),
                                                    self.working_set)
 
 
