@@ -4,10 +4,11 @@ only part of its diagonal moves.
 The frictionless KKT solve of an active set factorises C = G K^-1 G^T + diag(s) of its pairs
 (``solve_saddle``).  Within one load level the Hertz secants of the balls and the flank
 layer's shares are iterated, and each pass solves the same active pairs again with a new s: on a
-loaded HD 42 section about 365 of its 1050 pairs (the pairs at the edges of the tooth contacts
-and the balls) change their s, the others keep it to the last bit, and the off-diagonal part
-G K^-1 G^T does not change until the rows are re-linearised (``WorkingSet.generation``).
-Refactorising all of C each pass took 15 % of a study's solve.
+loaded HD 42 section (hd42-lhs-01, studies' model) 365 of its 1050 active pairs (5 balls, 360
+tooth pairs, the same ones pass after pass) change their s, the others keep it to the last bit,
+and the off-diagonal part G K^-1 G^T does not change until the rows are re-linearised
+(``WorkingSet.generation``).  Refactorising all of C each pass took 1.3 s of that design's 9 s
+profiled solve.
 
 So the pairs whose s moved are ordered last (*volatile*, V), the others first (*stable*, P):
 
@@ -82,10 +83,11 @@ def _cholesky(A: np.ndarray) -> np.ndarray:
 class ActiveFactor:
     """Factors of the active blocks of one solver (see the module docstring).
 
-    ``solver(C, positions, diag, working_set)`` returns a ``BlockSolve`` of the block C (its pairs
-    at the ascending working-set ``positions``, in that order; ``diag`` its diagonal without the
-    regularisation, which is what is compared from block to block) and raises
-    ``numpy.linalg.LinAlgError`` when C is not positive definite.
+    ``solver(C, positions, diag, working_set)`` returns C^-1 as a function of the block C (its
+    pairs at the ascending working-set ``positions``, in that order; ``diag`` its diagonal without
+    the regularisation, which is what is compared from block to block): a ``BlockSolve`` of the
+    kept factor, or a direct Cholesky solve for a block of fewer than ``min_pairs`` pairs.  It
+    raises ``numpy.linalg.LinAlgError`` when C is not positive definite.
     """
 
     def __init__(self, min_pairs: int = MIN_KEPT_PAIRS):
@@ -201,8 +203,11 @@ class ActiveFactor:
         kept.volatile_diag = np.concatenate([kept.volatile_diag, diag[new]])[order]
 
 
+Solve = Callable[[np.ndarray], np.ndarray]    # B -> C^-1 B
+
+
 def solve_frictionless_kkt(M: np.ndarray, rhs: np.ndarray, n: int,
-                            factor: Callable[[np.ndarray], BlockSolve]) -> np.ndarray:
+                           factor: Callable[[np.ndarray], Solve]) -> np.ndarray:
     """M^-1 rhs for a frictionless KKT matrix [[C, H], [H^T, E]] (n rows of C): through the
     Cholesky factor of its positive definite C (``factor``) and the small Schur complement of the
     modes, half the work of an LU of M; by ``solve_kkt`` if C is not positive definite."""
@@ -222,7 +227,7 @@ def solve_kkt(M: np.ndarray, rhs: np.ndarray) -> np.ndarray:
         return np.linalg.lstsq(M, rhs, rcond=None)[0]
 
 
-def solve_saddle(solve: BlockSolve, M: np.ndarray, rhs: np.ndarray, n: int) -> np.ndarray:
+def solve_saddle(solve: Solve, M: np.ndarray, rhs: np.ndarray, n: int) -> np.ndarray:
     """[[C, H], [H^T, E]] [p; alpha] = [r; s] with ``solve`` = C^-1: p = C^-1 (r - H alpha),
     (H^T C^-1 H - E) alpha = H^T C^-1 r - s."""
     H, E = M[:n, n:], M[n:, n:]

@@ -31,9 +31,8 @@ from hdwf.fe.structure import Structure
 
 FRICTION_MAX_IT = 30     # slip-direction iterations per load level (flank friction)
 SLIP_TOL = 1e-7          # mm: a slip below 0.1 nm over a step counts as none
-
-
 KKT_REGULARISATION = 1e-13   # times the block's largest compliance, added to its diagonal
+
 
 @dataclass(frozen=True)
 class ActiveBlock:

@@ -44,7 +44,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from hdwf.drive.geometry import ARCMIN
-from hdwf.fe.active_factor import ActiveFactor, BlockSolve, solve_frictionless_kkt, solve_kkt
+from hdwf.fe.active_factor import ActiveFactor, Solve, solve_frictionless_kkt, solve_kkt
 from hdwf.fe.contact_rows import PairId, Rows, stack_rows
 from hdwf.fe.flank_layer import LayerEdges, LayerIteration
 from hdwf.fe.friction import (FRICTION_MAX_IT, ActiveBlock, FlankLaw, FrictionLevel, NoFriction,
@@ -459,7 +459,7 @@ class ContactSolver:
                 + self.working_set.store.combine(positions, p_active) + problem.modes.watch @ alpha)
 
 
-    def _factor(self, block: ActiveBlock) -> Callable[[np.ndarray], BlockSolve]:
+    def _factor(self, block: ActiveBlock) -> Callable[[np.ndarray], Solve]:
         """C -> C^-1 of the block's C, kept across blocks that change only part of its diagonal."""
         return lambda C: self.active_factor.solver(C, block.positions, np.diag(block.compliance),
                                                    self.working_set)
