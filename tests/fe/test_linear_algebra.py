@@ -5,13 +5,11 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from hdwf.fe.active_factor import ActiveFactor, solve_frictionless_kkt, solve_kkt
 from hdwf.fe.bodies import factorize_spd, plane_stress_lame
 from hdwf.fe.column_store import CHUNK_ROWS, ColumnStore
-from hdwf.fe.active_factor import ActiveFactor, solve_frictionless_kkt, solve_kkt
 
-
-class _WorkingSet:
-    generation = 0
+from tests.fe.test_active_factor import _WorkingSet
 
 
 def _factor(n):

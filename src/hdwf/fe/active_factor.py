@@ -95,7 +95,7 @@ class ActiveFactor:
         self._kept: _Kept | None = None
         self._last_diag = np.zeros(0)      # diag(C) (without regularisation) by position, NaN: unseen
         self._source: tuple[object, int] | None = None   # (working set, generation) of the blocks
-        self.factorisations = 0            # full ones (for the tests and the benchmarks)
+        self.factorisations = 0            # full ones (for the tests)
         self.updates = 0                   # reuses of the stable factor
 
     def copy(self) -> "ActiveFactor":
@@ -132,8 +132,8 @@ class ActiveFactor:
 
     @staticmethod
     def _reusable(kept: _Kept, positions: np.ndarray, diag: np.ndarray) -> bool:
-        at = np.searchsorted(positions, kept.stable) if positions.size else np.zeros(0, dtype=np.int64)
-        holds = (at.size == 0 or (at.max() < positions.size and np.array_equal(positions[at], kept.stable)))
+        at = np.searchsorted(positions, kept.stable)      # (a kept factor has stable pairs)
+        holds = at.max() < positions.size and np.array_equal(positions[at], kept.stable)
         if not holds or not np.array_equal(diag[at], kept.stable_diag):
             return False
         return positions.size - kept.stable.size <= REBUILD_VOLATILE_FRACTION * positions.size
@@ -170,8 +170,8 @@ class ActiveFactor:
         self._extend(kept, C, positions, at_p, at_v, diag)
         cols = np.searchsorted(kept.volatile, positions[at_v])
         S = kept.S[np.ix_(cols, cols)]
-        S[np.diag_indices_from(S)] += diag[at_v] - kept.volatile_diag[cols] + (
-            C[at_v, at_v] - diag[at_v])     # the change of diag(s), and this block's regularisation
+        # the kept diagonal out, this block's in (its s and its regularisation)
+        S[np.diag_indices_from(S)] += C[at_v, at_v] - kept.volatile_diag[cols]
         return BlockSolve(kept.L11, kept.W[:, cols], _cholesky(S), at_p, at_v)
 
     @staticmethod
