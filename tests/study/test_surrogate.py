@@ -25,6 +25,18 @@ def test_a_quadratic_is_recovered_exactly():
     assert model.r2 == pytest.approx(1.0) and model.q2_loo == pytest.approx(1.0) and model.rmse < 1e-10
 
 
+def test_predictions_are_the_design_matrix_product():
+    """The surrogate is evaluated as a quadratic form; it must be Eq. 11's product term by term."""
+    rng = np.random.default_rng(5)
+    X = LO + rng.uniform(size=(30, 5)) * (HI - LO)
+    model = fit_quadratic(X, rng.normal(size=30), LO, HI)
+    Z = LO + rng.uniform(size=(200, 5)) * (HI - LO)
+    u = 2 * (Z - LO) / (HI - LO) - 1
+    expected = design_matrix(u) @ np.asarray(model.coefficients)
+    assert model.predict(Z) == pytest.approx(expected, abs=1e-12)
+    assert model.predict_unit((u + 1) / 2) == pytest.approx(expected, abs=1e-12)
+
+
 def test_q2_equals_brute_force_leave_one_out():
     rng = np.random.default_rng(3)
     X = LO + rng.uniform(size=(30, 5)) * (HI - LO)

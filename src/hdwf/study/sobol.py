@@ -5,9 +5,12 @@ from ``hdwf.study.doe``) of dimension 2k gives the matrices A and B, the radial 
 are built in SALib's row order (A, AB_1..AB_k, B per base point) and
 ``SALib.analyze.sobol.analyze`` returns S1 and ST (Saltelli 2010 / Jansen estimators) with
 bootstrap confidence intervals.  SALib draws all its resamples at once, N x resamples copies of
-the sample (1.8 GB at N = 262 144 and 100 resamples), so the bootstrap is asked of it in chunks of
-``BOOTSTRAP_CHUNK`` resamples, each kept (``keep_resamples``), and the half-width is SALib's
-z · std over all of them.  The exact indices of a quadratic come from its Legendre
+the sample (1.8 GB at N = 262 144 and 100 resamples), and gathers the resampled A and B again
+for every parameter and estimator (14 of a 36 s job).  So the point estimates are SALib's and
+the bootstrap is ``_bootstrap``, written here: SALib's resampling (its generator, seeded per chunk
+of ``BOOTSTRAP_CHUNK`` resamples) and estimators, each resample's A, B and variance gathered
+once, the same numbers to round-off (``tests/study/test_sobol.py``).  The half-width is SALib's
+z · std over all resamples.  The exact indices of a quadratic come from its Legendre
 expansion (background §5, Sudret 2008) and are the value the estimates converge to.
 """
 
@@ -82,15 +85,38 @@ def estimate_indices(model_unit, parameters: list[str], sampler: str, n: int, se
     base = unit_sample(sampler, n, 2 * k, seed)
     y = np.asarray(model_unit(radial_matrix(base)), float)
     problem = {"num_vars": k, "names": list(parameters), "bounds": [[0.0, 1.0]] * k}
-    runs = [salib_sobol.analyze(problem, y, calc_second_order=False, num_resamples=size, conf_level=conf_level,
-                                seed=seed + 7919 * i, keep_resamples=True)   # (SALib: seed 0 = unseeded)
-            for i, size in enumerate(_chunks(num_resamples))]
+    # (SALib's least bootstrap, 2 resamples: its half-widths are not used)
+    point = salib_sobol.analyze(problem, y, calc_second_order=False, num_resamples=2, seed=seed)
     z = norm.ppf(0.5 + conf_level / 2.0)
-    half = {name: z * np.vstack([r[f"{name}_conf_all"] for r in runs]).std(axis=0, ddof=1)
-            for name in ("S1", "ST")}
-    return pd.DataFrame({"parameter": parameters, "sampler": sampler, "n": n, "S1": runs[0]["S1"],
-                         "S1_conf": half["S1"], "ST": runs[0]["ST"], "ST_conf": half["ST"]},
+    resampled = _bootstrap(y, k, n, num_resamples, seed)
+    half = {name: z * resampled[name].std(axis=0, ddof=1) for name in ("S1", "ST")}
+    return pd.DataFrame({"parameter": parameters, "sampler": sampler, "n": n, "S1": point["S1"],
+                         "S1_conf": half["S1"], "ST": point["ST"], "ST_conf": half["ST"]},
                         columns=SOBOL_COLUMNS)
+
+
+def _bootstrap(y: np.ndarray, k: int, n: int, num_resamples: int, seed: int) -> dict[str, np.ndarray]:
+    """S1 and ST of each bootstrap resample (``num_resamples`` x k each), as
+    ``SALib.analyze.sobol.analyze(..., seed=seed + 7919 i, keep_resamples=True)`` gives them
+    for chunk i of ``_chunks(num_resamples)``: its normalised output, its resample indices and
+    its estimators (Saltelli 2010 first order, Jansen total)."""
+    y = (y - y.mean()) / y.std()
+    radial = y.reshape(n, k + 2)
+    A, B = radial[:, 0], radial[:, k + 1]
+    out = {"S1": np.empty((num_resamples, k)), "ST": np.empty((num_resamples, k))}
+    start = 0
+    for i, size in enumerate(_chunks(num_resamples)):
+        # (SALib leaves seed 0 unseeded; here every seed seeds)
+        r = np.random.default_rng(seed + 7919 * i).integers(n, size=(n, size))
+        Ar, Br = A[r], B[r]
+        var = np.var(np.r_[Ar, Br], axis=0)
+        rows = slice(start, start + size)
+        for j in range(k):
+            ABr = radial[:, j + 1][r]
+            out["S1"][rows, j] = np.mean(Br * (ABr - Ar), axis=0) / var
+            out["ST"][rows, j] = 0.5 * np.mean((Ar - ABr) ** 2, axis=0) / var
+        start += size
+    return out
 
 
 def _chunks(num_resamples: int) -> list[int]:

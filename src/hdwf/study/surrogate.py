@@ -50,11 +50,22 @@ class QuadraticSurrogate:
     extra: dict = field(default_factory=dict)
 
     def predict(self, X: np.ndarray) -> np.ndarray:
-        return design_matrix(to_centered(X, self.lower, self.upper)) @ np.asarray(self.coefficients)
+        return self._evaluate(to_centered(X, self.lower, self.upper))
 
     def predict_unit(self, U01: np.ndarray) -> np.ndarray:
         """Predict on points of the unit cube [0, 1)^k (as samplers produce them)."""
-        return design_matrix(2.0 * np.asarray(U01, float) - 1.0) @ np.asarray(self.coefficients)
+        return self._evaluate(2.0 * np.asarray(U01, float) - 1.0)
+
+    def _evaluate(self, u: np.ndarray) -> np.ndarray:
+        """c0 + u·a + u·(Q u) with Q holding the squares on its diagonal and the interactions
+        above it: the design matrix's product without the matrix (21 columns of 1.8 M rows for a
+        Sobol' estimate at N = 262 144)."""
+        k = len(self.parameters)
+        a = np.array([self.coefficient(p) for p in self.parameters])
+        Q = np.diag([self.coefficient(f"{p}^2") for p in self.parameters])
+        for i, j in combinations(range(k), 2):
+            Q[i, j] = self.coefficient(f"{self.parameters[i]}*{self.parameters[j]}")
+        return self.coefficient("1") + u @ a + np.einsum("ni,ni->n", u @ Q, u)
 
     def coefficient(self, term: str) -> float:
         return self.coefficients[self.terms.index(term)]
