@@ -41,8 +41,8 @@ from skfem import Basis, ElementTriP1, ElementVector, MeshTri, asm
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
 from hdwf.drive.mesh import BodyMesh
-from hdwf.fe.contact_geometry import boundary_edge_normals
 from hdwf.fe.changes import ModelChanges
+from hdwf.fe.contact_geometry import boundary_edge_normals
 
 
 # --------------------------------------------------------------------------------------
