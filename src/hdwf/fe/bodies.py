@@ -42,7 +42,6 @@ from skfem.models.elasticity import lame_parameters, linear_elasticity
 
 from hdwf.drive.mesh import BodyMesh
 from hdwf.fe.changes import ModelChanges
-from hdwf.fe.contact_geometry import boundary_edge_normals
 
 
 # --------------------------------------------------------------------------------------
@@ -209,20 +208,6 @@ class Body:
     watch_index: np.ndarray | None = None   # (2, nnodes) position in the watch vector or -1
     tie: sp.csr_matrix | None = None   # half model: body dofs = tie @ reduced dofs
     tied_nodes: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
-    _outlines: dict = field(default_factory=dict, init=False, repr=False, compare=False)
-
-    def outline(self, edge_set: str, watched_only: bool = True) -> tuple[np.ndarray, np.ndarray]:
-        """The edges (m, 2) of ``edge_set`` (those with both nodes watched, or all) and their
-        outward unit normals (2, m) in the reference configuration, found once: every
-        detection of the contact rows asks for them, and finding them sorts every edge of
-        the mesh."""
-        key = (edge_set, watched_only)
-        if key not in self._outlines:
-            E = self.body_mesh.edge_sets[edge_set]
-            if watched_only:
-                E = E[np.isin(E[:, 0], self.watch_nodes) & np.isin(E[:, 1], self.watch_nodes)]
-            self._outlines[key] = (E, boundary_edge_normals(self.body_mesh.mesh, E))
-        return self._outlines[key]
 
     @property
     def x(self) -> np.ndarray:

@@ -166,7 +166,9 @@ def match_to_outline(sb: "Body", nodes: np.ndarray, mb: "Body", edge_set: str,
     """``nodes`` of body ``sb`` against the watched ``edge_set`` segments of body ``mb``, both
     at the displacement ``u_watch`` (``closest_segments``)."""
     xs = sb.x[:, nodes] + sb.node_displacements(nodes, u_watch)
-    E, nrm = mb.outline(edge_set)
+    E = mb.body_mesh.edge_sets[edge_set]
+    E = E[(mb.watch_index[0, E[:, 0]] >= 0) & (mb.watch_index[0, E[:, 1]] >= 0)]
+    nrm = boundary_edge_normals(mb.body_mesh.mesh, E)
     xa = mb.x[:, E[:, 0]] + mb.node_displacements(E[:, 0], u_watch)
     xb = mb.x[:, E[:, 1]] + mb.node_displacements(E[:, 1], u_watch)
     gap, seg, t = closest_segments(xs, xa, xb, nrm)

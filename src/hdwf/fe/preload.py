@@ -25,7 +25,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from hdwf.fe.contact_geometry import closest_segments
+from hdwf.fe.contact_geometry import boundary_edge_normals, closest_segments
 from hdwf.fe.contact_rows import tooth_rows
 from hdwf.fe.changes import ModelChanges
 from hdwf.fe.friction import FlankFriction, NoFriction, flank_law
@@ -182,7 +182,8 @@ def overlap_outside_zones(model: LostMotionModel, level: LevelSolution) -> float
         sn = sn[~np.isin(sn, sb.watch_nodes)]
         if sn.size == 0:
             continue
-        E, normals = mb.outline(f"{master}_teeth", watched_only=False)
-        gap, _, _ = closest_segments(x[slave][:, sn], x[master][:, E[:, 0]], x[master][:, E[:, 1]], normals)
+        E = mb.body_mesh.edge_sets[f"{master}_teeth"]
+        gap, _, _ = closest_segments(x[slave][:, sn], x[master][:, E[:, 0]], x[master][:, E[:, 1]],
+                                     boundary_edge_normals(mb.body_mesh.mesh, E))
         worst = max(worst, float(-gap.min()))
     return worst
