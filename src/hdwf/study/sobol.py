@@ -27,7 +27,7 @@ from hdwf.study.doe import unit_sample
 from hdwf.study.surrogate import QuadraticSurrogate
 
 SOBOL_COLUMNS = ["parameter", "sampler", "n", "S1", "S1_conf", "ST", "ST_conf"]
-BOOTSTRAP_CHUNK = 20   # resamples per SALib call (its memory grows with N x resamples)
+BOOTSTRAP_CHUNK = 20   # resamples drawn at once (the memory grows with N x resamples)
 
 
 def exact_quadratic_indices(coef_linear, coef_square, coef_interaction) -> tuple[np.ndarray, np.ndarray]:
@@ -120,7 +120,8 @@ def _bootstrap(y: np.ndarray, k: int, n: int, num_resamples: int, seed: int) -> 
 
 
 def _chunks(num_resamples: int) -> list[int]:
-    """``num_resamples`` split into SALib calls of at most ``BOOTSTRAP_CHUNK`` (each >= 2)."""
+    """``num_resamples`` split into chunks of at most ``BOOTSTRAP_CHUNK``, each of 2 or more (the
+    chunks SALib was once called with, so the seeds and resamples stay the same)."""
     if num_resamples < 2:
         raise ValueError(f"num_resamples must be >= 2 (a standard deviation), not {num_resamples}")
     sizes = [BOOTSTRAP_CHUNK] * (num_resamples // BOOTSTRAP_CHUNK)
