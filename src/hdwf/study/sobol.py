@@ -16,8 +16,6 @@ expansion (background §5, Sudret 2008) and are the value the estimates converge
 
 from __future__ import annotations
 
-from itertools import combinations
-
 import numpy as np
 import pandas as pd
 from SALib.analyze import sobol as salib_sobol
@@ -51,15 +49,9 @@ def exact_quadratic_indices(coef_linear, coef_square, coef_interaction) -> tuple
 
 
 def exact_indices(surrogate: QuadraticSurrogate) -> pd.DataFrame:
-    k = len(surrogate.parameters)
-    params = surrogate.parameters
-    a = [surrogate.coefficient(p) for p in params]
-    q = [surrogate.coefficient(f"{p}^2") for p in params]
-    r = np.zeros((k, k))
-    for i, j in combinations(range(k), 2):
-        r[i, j] = surrogate.coefficient(f"{params[i]}*{params[j]}")
+    _, a, q, r = surrogate.polynomial()
     s1, st = exact_quadratic_indices(a, q, r)
-    return pd.DataFrame({"parameter": params, "sampler": "exact", "n": 0, "S1": s1, "S1_conf": 0.0,
+    return pd.DataFrame({"parameter": surrogate.parameters, "sampler": "exact", "n": 0, "S1": s1, "S1_conf": 0.0,
                          "ST": st, "ST_conf": 0.0}, columns=SOBOL_COLUMNS)
 
 
