@@ -45,7 +45,9 @@ def test_version(capsys):
     assert capsys.readouterr().out.strip() == f"hdwf {__version__}"
 
 
-def test_a_closed_pipe_ends_quietly(monkeypatch):
+def test_a_closed_pipe_ends_quietly(monkeypatch, capsys):
+    """`hdwf effects | head`: exit 1 with nothing on stderr, and what is left of stdout goes to
+    /dev/null (so the interpreter's own flush at exit cannot raise again)."""
     read_end, write_end = os.pipe()
 
     class ClosedPipe:
@@ -61,6 +63,8 @@ def test_a_closed_pipe_ends_quietly(monkeypatch):
     monkeypatch.setattr(sys, "stdout", ClosedPipe())
     try:
         assert main(["effects"]) == 1
+        assert capsys.readouterr().err == ""
+        assert os.path.samestat(os.fstat(write_end), os.stat(os.devnull))
     finally:
         os.close(read_end)
         os.close(write_end)

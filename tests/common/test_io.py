@@ -1,5 +1,8 @@
 """Artefacts: atomic writes, units and provenance in the Parquet metadata."""
 
+import re
+from importlib import metadata
+
 import pandas as pd
 import pyarrow.parquet as pq
 import pytest
@@ -39,7 +42,12 @@ def test_lost_motion_schema_units_and_provenance(tmp_path, paper_dir):
     assert schema.field("d_mm").metadata[b"unit"] == b"mm"
     stored, _ = read_parquet_meta(out)
     assert stored["config_hash"] == config_hash({"x": 1})
-    assert stored["packages"]["numpy"] and stored["git_commit"]
+    assert stored["packages"]["numpy"] == metadata.version("numpy")
+    assert stored["packages"]["hdwf"] == metadata.version("hdwf")
+    if (ROOT / ".git").exists():     # a clone (as CI and the README make): its commit
+        assert re.fullmatch(r"[0-9a-f]{40}(-dirty)?", stored["git_commit"])
+    else:
+        assert stored["git_commit"] == "unknown (not a git checkout)"
     df = pd.read_parquet(out)
     assert df["phi_plus_arcmin"].isna().all()  # the paper gives only Φ
     assert (df["status"] == "published").all()
