@@ -36,6 +36,16 @@ def test_study_stages_solve_the_switched_on_effects(tmp_path):
     alone = solve_lost_motion(g, MeshSettings.from_mapping(MESH).mesh(g), 1, changes=preload_only)
     series_arcmin = 2 * (g.torque / 1000.0) / K_CUP * 180 / math.pi * 60  # g.torque in N·mm
     assert row["lost_motion_arcmin"] - alone.lost_motion_arcmin == pytest.approx(series_arcmin, rel=1e-9)
+    # the curve of the test 0 -> +T -> 0 -> -T -> 0 (one step a ramp) ends where the row does:
+    # its twist from the start to +T is φ, to -T minus φ' (the cup's twist included)
+    curve = pd.read_parquet(out.curve).sort_values("step")
+    T = g.torque / 1000.0
+    assert curve["torque_Nm"].to_numpy() == pytest.approx([0.0, T, 0.0, -T, 0.0], abs=1e-3 * T)
+    twist = curve["twist_arcmin"].to_numpy()
+    assert twist[0] == 0.0
+    assert twist[1] == pytest.approx(row["phi_plus_arcmin"], rel=1e-12)
+    assert -twist[3] == pytest.approx(row["phi_minus_arcmin"], rel=1e-12)
+    assert twist[1] - twist[3] == pytest.approx(row["lost_motion_arcmin"], rel=1e-12)
     # 0.1 m = 18 µm exceeds the 10 µm of rigid clearance per flank: no play left, Φ is elastic only
     assert alone.lost_motion_arcmin < 0.34  # a tenth of the bare section's 3.4 arcmin
 
