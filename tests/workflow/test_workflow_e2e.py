@@ -14,6 +14,8 @@ import pandas as pd
 import pytest
 
 from hdwf.common.io import read_json, read_parquet_meta
+from hdwf.common.provenance import config_hash
+from hdwf.config import load_config
 
 from conftest import ROOT
 
@@ -41,15 +43,21 @@ def test_paper_target(paper_run):
     ws = paper_run
     pdf = ws / "results/paper/report.pdf"
     assert pdf.read_bytes()[:5] == b"%PDF-" and pdf.stat().st_size > 100_000
+    config_digest = config_hash(load_config(ws / "config.yaml"))
     for unit, rho in (("hd42", 0.6758), ("hd120", 0.7027)):
         corr = pd.read_parquet(ws / f"results/paper/{unit}/correlation.parquet").set_index("parameter")
         assert round(corr.loc["rFS", "spearman_rho"], 4) == rho
         sob = pd.read_parquet(ws / f"results/paper/{unit}/sobol.parquet")
         assert set(sob["sampler"]) == {"exact", "lhs", "halton", "sobol"}
         assert sob["n"].max() >= 65536
+        # the Sobol'-sequence estimate at N = 65 536 against the surrogate's exact indices: 4.4e-4
+        # and 1.5e-4 at most (docs/results.md); a wrong estimator or sample misses by far more
+        exact = sob[sob["sampler"] == "exact"].set_index("parameter")[["S1", "ST"]]
+        est = sob[(sob["sampler"] == "sobol") & (sob["n"] == 65536)].set_index("parameter")[["S1", "ST"]]
+        assert len(est) == 5 and (est - exact.loc[est.index]).abs().to_numpy().max() < 2e-3
         assert read_json(ws / f"results/paper/{unit}/surrogate.json")["r2"] >= 0.98
         prov, _ = read_parquet_meta(ws / f"results/paper/{unit}/lost_motion.parquet")
-        assert len(prov["config_hash"]) == 64
+        assert prov["config_hash"] == config_digest      # the hash `hdwf check-config` prints
     again = subprocess.run([SNAKEMAKE, "--cores", "2", "paper", "--dry-run"], cwd=ws, capture_output=True,
                            text=True, timeout=120)
     assert "Nothing to be done" in again.stdout + again.stderr  # a rerun rebuilds nothing
@@ -136,13 +144,20 @@ def test_fe_study_chain_on_a_coarse_mesh(tmp_path):
     assert len(lm) == 22 and (lm["status"] == "ok").all()
     assert list(lm.columns[:10]) == ["design_id", "d_mm", "D_mm", "Gr_mm", "rFS_mm", "rCS_mm", "phi_plus_arcmin",
                                      "phi_minus_arcmin", "lost_motion_arcmin", "status"]
-    # Φ = φ + φ′ by definition, and the solve costs more than one factorisation of the same matrix.
-    assert (lm["lost_motion_arcmin"] - lm["phi_plus_arcmin"] - lm["phi_minus_arcmin"]).abs().max() < 1e-9
+    # the solve costs more than one factorisation of the same matrix
     assert (lm["solve_s"] > lm["factorize_s"]).all()
     curves = pd.read_parquet(ws / targets[1])
     assert list(curves.columns) == ["design_id", "step", "torque_Nm", "twist_arcmin"]
     assert len(curves) == 22 * 5  # 0 -> +T -> 0 -> -T -> 0 with one step per ramp
-    assert curves["torque_Nm"].abs().max() == pytest.approx(0.96)
+    assert curves["torque_Nm"].abs().max() == pytest.approx(0.96)   # 4 % of HD 42's T_N, 24 N·m
+    # the aggregation keeps each design's curve with its row: the twist at +T is its φ, at -T
+    # minus its φ'
+    at = curves.set_index(["design_id", "step"])["twist_arcmin"].unstack()
+    row = lm.set_index("design_id").loc[at.index]
+    assert (at[0] == 0.0).all()
+    assert (at[1] - row["phi_plus_arcmin"]).abs().max() < 1e-12
+    assert (-at[3] - row["phi_minus_arcmin"]).abs().max() < 1e-12
+    assert lm["phi_plus_arcmin"].gt(0).all() and lm["phi_minus_arcmin"].gt(0).all()
     assert (ws / "results/fe/hd42/mesh/hd42-lhs-01.msh").stat().st_size > 0
     bench = (ws / "results/fe/hd42/benchmarks/solve_hd42-lhs-01.tsv").read_text().splitlines()
     assert bench[0].startswith("s\t") and len(bench) == 2
