@@ -169,6 +169,9 @@ def assumptions_table() -> list[dict]:
 
 E_STEEL = 210_000.0  # MPa, paper Sec. 4
 NU_STEEL = 0.3       # paper Sec. 4
+# the largest tip round (units of m): its tangent length (about 0.64 rho at a 115 deg corner)
+# must stay on the narrowest tip land, HD 42's FS tip, 0.47 m to either side of its middle
+MAX_TIP_ROUND_M = 0.25
 
 
 @dataclass(frozen=True)
@@ -218,6 +221,8 @@ class DriveGeometry:
     interference_m: float = 0.0
     # tip relief, in units of the relief the FS tooth's path needs (``hdwf.drive.relief``)
     tip_relief: float = 0.0
+    # radius of the round of the FS and CS tip corners, in units of m (0 = sharp corners)
+    tip_round_m: float = 0.0
     # deflection coefficient: the nominal bearing pushes the FS out by this many w0 (> 1: the
     # major-axis teeth are pressed radially into the CS spaces)
     deflection_coeff: float = 1.0
@@ -250,6 +255,11 @@ class DriveGeometry:
     def interference(self) -> float:
         """Normal interference per flank (mm) the FS teeth are made thicker by (preload)."""
         return self.interference_m * self.module
+
+    @property
+    def tip_round(self) -> float:
+        """Radius (mm) of the FS and CS tip corners' round (0: sharp)."""
+        return self.tip_round_m * self.module
 
     @property
     def addendum(self) -> float:
@@ -388,7 +398,7 @@ def geometric_backlash_arcmin(g: DriveGeometry, radial_shortfall_mm: float = 0.0
 def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: float,
                    rCS_mm: float, interference_m: float = 0.0,
                    tip_relief: float = 0.0, deflection_coeff: float = 1.0,
-                   addendum_frac: float | None = None,
+                   addendum_frac: float | None = None, tip_round_m: float = 0.0,
                    offset_direction: str = "normal") -> DriveGeometry:
     """Geometry of one design of unit "hd42" or "hd120" (all lengths in mm).
 
@@ -403,6 +413,12 @@ def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: fl
     tooth's path needs to leave the mesh without crossing the CS tips
     (``hdwf.drive.relief``); 0 (the default) keeps the plain involutes, whose tips cross
     51-69 deg from the major axis.
+
+    ``tip_round_m`` (in [0, 0.25], units of m): the tip corners of FS and CS teeth rounded with
+    this radius, tangent to the flank and the tip circle (``hdwf.drive.sector_mesh``); 0 (the
+    default) keeps them sharp.  Where the tips cross in the exit zone a sharp corner pressed
+    into a flank is a contact a node or two long that moves with the mesh; a round is
+    resolved by several (docs/fe-model.md, "Mesh convergence").
 
     ``deflection_coeff`` (kappa in [1, 2)): the cam is sized so that the nominal bearing pushes
     the FS out by kappa * w0 at the major axis; 1 (the default) is the 2-tooth difference with
@@ -419,6 +435,8 @@ def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: fl
         raise ValueError(f"interference_m must be finite and >= 0, got {interference_m!r}")
     if not (tip_relief >= 0.0 and math.isfinite(tip_relief)):
         raise ValueError(f"tip_relief must be finite and >= 0, got {tip_relief!r}")
+    if not (0.0 <= tip_round_m <= MAX_TIP_ROUND_M):
+        raise ValueError(f"tip_round_m must be in [0, {MAX_TIP_ROUND_M}] (units of m), got {tip_round_m!r}")
     if offset_direction not in ("normal", "radial"):
         raise ValueError(f"offset_direction must be 'normal' or 'radial', got {offset_direction!r}")
     if not (1.0 <= deflection_coeff < 2.0):
@@ -454,7 +472,7 @@ def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: fl
         r_cs_outer=r_cs_pitch + hf + t["cs_rim"],
         cam_A=A, cam_B=B, cam_n=t["cam_n"], interference_m=float(interference_m),
         tip_relief=float(tip_relief), deflection_coeff=float(deflection_coeff),
-        offset_direction=offset_direction,
+        offset_direction=offset_direction, tip_round_m=float(tip_round_m),
     )
 
 

@@ -120,6 +120,11 @@ def _relieved_radii(g: DriveGeometry, r0: float, r1: float, r_tip: float) -> np.
 BODY_NAMES = ("fs", "cs", "ir", "or")
 
 
+def _round_segments(s: dict) -> int:
+    """Segments on a tip round: a fifth of a flank's, at least 2 (2 on the default mesh)."""
+    return max(2, int(round(s["n_flank"] / 5)))
+
+
 def build_mesh(geom: DriveGeometry, elements_over_height: int = 10,
                elements_over_thickness: int = 6, refinement: float = 1.0,
                path: str | None = None, symmetry: str = "full",
@@ -184,12 +189,14 @@ def _toothed_body(name: str, g: DriveGeometry, s: dict, half: bool) -> BodyMesh:
     and copied round (``hdwf.drive.sector_mesh``)."""
     if name == "fs":
         rr = _relieved_radii(g, g.r_fs_root, g.r_fs_tip, g.r_fs_tip)
-        prof = RingProfile(g.z_fs, rr, fs_half_angle(g, rr), g.r_fs_bore, "fs_teeth", "fs_bore")
-        sizes, thickness = RingSizes(s["tooth"], s["fs_bore"], int(s["n_flank"])), g.face_fs
+        prof = RingProfile(g.z_fs, rr, fs_half_angle(g, rr), g.r_fs_bore, "fs_teeth", "fs_bore",
+                           g.tip_round, True)
+        sizes, thickness = RingSizes(s["tooth"], s["fs_bore"], int(s["n_flank"]), _round_segments(s)), g.face_fs
     else:
         rr = _relieved_radii(g, g.r_cs_tip, g.r_cs_root, g.r_cs_tip)
-        prof = RingProfile(g.z_cs, rr, cs_half_space_angle(g, rr), g.r_cs_outer, "cs_teeth", "cs_outer")
-        sizes, thickness = RingSizes(s["tooth"], s["cs_outer"], int(s["n_flank"])), g.face_cs
+        prof = RingProfile(g.z_cs, rr, cs_half_space_angle(g, rr), g.r_cs_outer, "cs_teeth", "cs_outer",
+                           g.tip_round, False)
+        sizes, thickness = RingSizes(s["tooth"], s["cs_outer"], int(s["n_flank"]), _round_segments(s)), g.face_cs
     sector = mesh_period(prof, sizes, MESH_ALGORITHM, LC_INTEGRATION_PRECISION)
     p, t, edges = copy_round(sector, prof.z, half)
     bm = BodyMesh(name, MeshTri(p, _counter_clockwise(p, t)), thickness)

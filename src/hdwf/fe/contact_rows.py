@@ -370,7 +370,8 @@ def tooth_rows(structure: Structure, geom: DriveGeometry, u_watch: np.ndarray, c
         sn_fs = fs.independent(np.intersect1d(fs.body_mesh.node_sets["fs_teeth"], fs.watch_nodes))
         cn = np.intersect1d(cs.body_mesh.node_sets["cs_teeth"], cs.watch_nodes)
         r_cn = np.hypot(cs.x[0, cn], cs.x[1, cn])
-        tip_band = geom.r_cs_tip + CS_TIP_BAND * (geom.r_cs_root - geom.r_cs_tip)
+        # a rounded tip's nodes lie within about 0.6 of its radius of the tip circle
+        tip_band = geom.r_cs_tip + max(CS_TIP_BAND * (geom.r_cs_root - geom.r_cs_tip), geom.tip_round)
         sn_cs = cs.independent(cn[r_cn <= tip_band])
     else:
         sn_fs, sn_cs = nodes
