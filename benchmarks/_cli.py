@@ -10,20 +10,22 @@ from hdwf import PARAMETER_COLUMNS
 
 
 def add_shape_arguments(ap: argparse.ArgumentParser) -> None:
-    """--deflection, --addendum-frac and --offsets (docs/fe-alternatives.md, "A deeper cam" and
-    "Reading r_FS, r_CS as rack shifts")."""
+    """--deflection, --addendum-frac, --offsets (docs/fe-alternatives.md, "A deeper cam" and
+    "Reading r_FS, r_CS as rack shifts") and --tip-round (docs/fe-model.md, "Mesh convergence")."""
     ap.add_argument("--deflection", type=float, default=1.0,
                     help="DriveGeometry.deflection_coeff: the cam pushes this many w0 (> 1: a deeper cam)")
     ap.add_argument("--addendum-frac", type=float, default=None,
                     help="addendum / tooth height of FS and CS (default the unit's 0.45)")
     ap.add_argument("--offsets", choices=("normal", "radial"), default="normal",
                     help="DriveGeometry.offset_direction: r_FS, r_CS as normal flank offsets or rack shifts")
+    ap.add_argument("--tip-round", type=float, default=0.0,
+                    help="DriveGeometry.tip_round_m: radius of the FS and CS tip corners' round, units of m")
 
 
 def shape_of(args: argparse.Namespace) -> dict:
     """The ``drive_geometry`` keywords the options ask for."""
     return {"deflection_coeff": args.deflection, "addendum_frac": args.addendum_frac,
-            "offset_direction": args.offsets}
+            "offset_direction": args.offsets, "tip_round_m": args.tip_round}
 
 
 def check_names(names) -> None:

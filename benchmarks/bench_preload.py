@@ -19,7 +19,8 @@ Pearson correlation ours vs paper) and the paper's dPhi/dr_FS on the same design
 ``--summary-only`` re-reads ``--out`` and prints the summary.
 ``--deflection 1.4 --addendum-frac 0.38 --interference 0`` solves the other preload, a deeper
 cam (``DriveGeometry.deflection_coeff``; docs/fe-alternatives.md, "A deeper cam");
-``--offsets radial`` reads r_FS, r_CS as rack shifts (``DriveGeometry.offset_direction``).
+``--offsets radial`` reads r_FS, r_CS as rack shifts (``DriveGeometry.offset_direction``);
+``--tip-round 0.1`` rounds the tip corners (``DriveGeometry.tip_round_m``).
 ``--flank-layer 1167,2333`` solves each interference with a compliant flank layer of each
 thickness (modules; effect ``flank_layer``, docs/fe-model.md, "A compliant flank layer").
 """
@@ -81,7 +82,7 @@ def solve_all(unit: str, sets: list[int], interferences: list[float], zone90: bo
             rec = {"unit": unit, "set": s, "interference_m": im, "flank_layer_m": lam, "tip_relief": tip_relief,
                    "deflection_coeff": g.deflection_coeff, "addendum_frac": round(g.addendum / (
                        g.r_fs_tip - g.r_fs_root), 6), "offset_direction": g.offset_direction,
-                   "mesh": f"{eh}x{et}",
+                   "tip_round_m": g.tip_round_m, "mesh": f"{eh}x{et}",
                    "zone_deg": zone_deg if zone_deg else (90.0 if g.preloaded else 35.0),
                    "status": r.status, "overlap_outside_zones_um": r.overlap_outside_zones_um,
                    "reason": r.reason[:200], "phi": r.lost_motion_arcmin,
