@@ -5,8 +5,8 @@ Meshes the design of ``--designs`` (a study's ``designs.parquet``, e.g. the defa
 over the tooth height x thickness (default 10x6, the studies'; half model, 5 steps per ramp),
 solves it with ``--effects`` switched on (default: the ``fe.effects`` of ``config.yaml``) and
 appends one row per mesh to ``--out`` (CSV: design, mesh, refinement, effects, zone, nodes, status,
-Φ, φ+, φ−, teeth in contact, overlap left outside the zones, seconds).  ``--tip-round 0`` keeps
-the FS and CS tip corners sharp (``drive_geometry``'s ``tip_round_m``; default the model's).  ``--mesh 20x6`` refines the teeth (their size is the finer
+Φ, φ+, φ−, teeth in contact, overlap left outside the zones, seconds).  ``--tip-round 0.1`` rounds
+the FS and CS tip corners with a radius of 0.1 m (``drive_geometry``'s ``tip_round_m``).  ``--mesh 20x6`` refines the teeth (their size is the finer
 of height / 20 and thickness / 6) and what grades from them (the FS rim, the CS rim where four
 tooth sizes decide), not the bearing rings.  ``--zone 45`` solves the contacts of the teeth within
 45 deg of a major axis only (default: every tooth, as a preload needs) and records the overlap
@@ -38,18 +38,16 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def refine(unit: str, designs: Path, design: str, refinements: list[float], effects: dict, out: Path,
-           per_tooth: tuple[int, int] = (10, 6), zone_deg: float | None = None,
-           tip_round_m: float | None = None) -> None:
+           per_tooth: tuple[int, int] = (10, 6), zone_deg: float | None = None, tip_round_m: float = 0.0) -> None:
     params = design_parameters(designs, design)
     changes = model_changes(effects)
-    shape = changes.geometry_part() | ({} if tip_round_m is None else {"tip_round_m": tip_round_m})
-    geom = geometry_of(unit, params, **shape)
+    geom = geometry_of(unit, params, **changes.geometry_part(), tip_round_m=tip_round_m)
     for ref in refinements:
         t0 = time.perf_counter()
         mesh = build_mesh(geom, *per_tooth, ref, symmetry="half")
         res = solve_lost_motion(geom, mesh, steps_per_ramp=5, changes=changes, zone_deg=zone_deg)
         rec = {"design": design, "mesh": "x".join(map(str, per_tooth)), "refinement": ref, "effects": json.dumps(effects),
-               "tip_round_m": geom.tip_round_m,
+               "tip_round_m": tip_round_m,
                "zone_deg": zone_deg,   # blank: the default zones (every tooth with a preload)
                "nodes": sum(b.mesh.p.shape[1] for b in mesh.bodies.values()), "status": res.status,
                "phi": res.lost_motion_arcmin, "phi_plus": res.phi_plus_arcmin, "phi_minus": res.phi_minus_arcmin,
@@ -71,8 +69,7 @@ if __name__ == "__main__":
     ap.add_argument("--out", type=Path, default=Path("refine.csv"))
     ap.add_argument("--mesh", default="10x6", help="elements over the tooth height x thickness")
     ap.add_argument("--zone", type=float, default=None, help="half width (deg) of the solved tooth zones")
-    ap.add_argument("--tip-round", type=float, default=None,
-                    help="radius of the tip corners' round, units of m (default: the model's)")
+    ap.add_argument("--tip-round", type=float, default=0.0, help="radius of the tip corners' round, units of m")
     a = ap.parse_args()
     effects = json.loads(a.effects) if a.effects else \
         yaml.safe_load((ROOT / "config.yaml").read_text())["fe"].get("effects", {})

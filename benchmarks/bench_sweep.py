@@ -83,7 +83,7 @@ def sweep(unit: str, base: dict[str, float], name: str, values: list[float], pre
     rows = []
     for value in values:
         params = {**nominal, **base, name: value}
-        g = geometry_of(unit, params, **(reshape | (shape or {})))     # a shape option overrides the model's
+        g = geometry_of(unit, params, **reshape, **(shape or {}))
         mesh = build_mesh(g, elements_over_height=mesh_size[0], elements_over_thickness=mesh_size[1],
                           symmetry="half")
         r = solve_lost_motion(g, mesh, steps_per_ramp=steps_per_ramp, changes=changes, keep_fields=fit)

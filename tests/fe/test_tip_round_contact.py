@@ -38,7 +38,8 @@ def test_second_pass_watches_every_node_of_the_cs_rounds():
 def test_rounded_tips_converge_where_sharp_ones_did_not():
     """The studies' model (0.3 m on 3900 modules) on hd42-lhs-14 with the tip corners rounded
     by 0.1 m: Φ on the default and the 1.25x finer mesh within the 2 % the issue asks of every
-    `fe` design (measured 0.2387 and 0.2384 arcmin)."""
+    `fe` design (measured 0.2387 and 0.2384 arcmin). On other designs the rounds do not help
+    (docs/fe-alternatives.md, "Rounded tip corners"): this checks the round's contact, not a cure."""
     g = drive_geometry(*HD42_LHS14, interference_m=0.3, tip_relief=PRELOAD_TIP_RELIEF, tip_round_m=0.1)
     phi = []
     for refinement in (1.0, 1.25):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from hdwf.drive.design import MeshSettings, geometry_of
-from hdwf.drive.relief import PRELOAD_TIP_RELIEF, PRELOAD_TIP_ROUND_M
+from hdwf.drive.relief import PRELOAD_TIP_RELIEF
 from hdwf.fe import ModelChanges, solve_lost_motion
 from hdwf.fe.solver import TOL_GAP
 from hdwf.study.convergence import twist_resolution_arcmin
@@ -29,8 +29,7 @@ def test_a_reshaping_change_needs_its_geometry():
     """The solve cannot thicken the teeth of a mesh it is given: it refuses, naming the field."""
     g = geometry_of("hd42", SPECIMEN)
     changes = model_changes({"preload": {"interference_m": 0.1}})
-    assert changes.geometry_part() == {"interference_m": 0.1, "tip_relief": PRELOAD_TIP_RELIEF,
-                                       "tip_round_m": PRELOAD_TIP_ROUND_M}
+    assert changes.geometry_part() == {"interference_m": 0.1, "tip_relief": PRELOAD_TIP_RELIEF}
     with pytest.raises(ValueError, match="interference_m"):
         solve_lost_motion(g, MeshSettings.from_mapping(MESH).mesh(g), 1, changes=changes)
 

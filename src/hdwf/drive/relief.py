@@ -50,11 +50,6 @@ from scipy.optimize import brentq
 # derived one: the mounted FS withdraws a little less than the rack path, and at 1.0 the tips of
 # loose-bearing designs still touched at the exit (docs/fe-model.md, "Tip relief").
 PRELOAD_TIP_RELIEF = 1.1
-# The radius (units of m) the tip corners of a preloaded profile are rounded with: where the tips
-# still cross in the exit zone a sharp corner pressed into a flank is a contact a node or two
-# long whose force moves with the mesh; a round is resolved by its own segments
-# (docs/fe-model.md, "Mesh convergence").  0.1 m, a usual tip rounding of cut gear teeth.
-PRELOAD_TIP_ROUND_M = 0.1
 
 
 def _advance(two_phi, kappa):

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-from hdwf.drive.relief import PRELOAD_TIP_RELIEF, PRELOAD_TIP_ROUND_M
+from hdwf.drive.relief import PRELOAD_TIP_RELIEF
 
 
 @dataclass(frozen=True)
@@ -42,8 +42,7 @@ class ModelChanges:
       follows the load path with the Masing rule (``hdwf.fe.series.microslip_twist``).
     * ``flank_interference_m``: preloaded engagement, the FS teeth thicker by this many modules
       on each flank (``DriveGeometry.interference_m``), their tips relieved as a preload needs
-      (``hdwf.drive.relief.PRELOAD_TIP_RELIEF``) and the FS and CS tip corners rounded
-      (``PRELOAD_TIP_ROUND_M``). It changes the section's outline, so the
+      (``hdwf.drive.relief.PRELOAD_TIP_RELIEF``). It changes the section's outline, so the
       geometry must carry it (``geometry_part``): a variant with it gets an FS meshed on its own.
     * ``flank_layer_m``: a compliant layer on the tooth flanks, as compliant as a steel layer
       this many modules thick: c = flank_layer_m m / E (mm of approach per MPa of contact
@@ -72,11 +71,9 @@ class ModelChanges:
         return 1e3 * self.flank_layer_m * module_mm / E_MPa
 
     def geometry_part(self) -> dict[str, float]:
-        """The ``drive_geometry`` arguments these changes need (``interference_m``, ``tip_relief``,
-        ``tip_round_m``)."""
-        preloaded = self.flank_interference_m > 0
-        return {"interference_m": self.flank_interference_m, "tip_relief": PRELOAD_TIP_RELIEF if preloaded else 0.0,
-                "tip_round_m": PRELOAD_TIP_ROUND_M if preloaded else 0.0}
+        """The ``drive_geometry`` arguments these changes need (``interference_m``, ``tip_relief``)."""
+        relieved = PRELOAD_TIP_RELIEF if self.flank_interference_m > 0 else 0.0
+        return {"interference_m": self.flank_interference_m, "tip_relief": relieved}
 
     def fe_part(self) -> "ModelChanges":
         """The changes that need a new contact solve: all but the series elements."""

@@ -202,7 +202,7 @@ def _exit_zone_load(lm: pd.DataFrame) -> str:
     if not far.any():
         return f"Every loaded tooth at +T lies within {fmt(arc.max(), 1)}° of a major axis. "
     return (f"In {int(far.sum())} of {len(lm)} designs teeth farther than {EXIT_ARC_DEG:g}° from a major axis "
-            f"carry load at +T (out to {fmt(arc.max(), 1)}°): relieved, rounded tips still crossing on the way out of "
+            f"carry load at +T (out to {fmt(arc.max(), 1)}°): relieved tips still crossing on the way out of "
             "mesh, from the uniform preload allowance. The paper reports tooth interference in its own model "
             "too, near the minor axis and 60° from it; a deeper cam that engages the major axis only "
             "matches HD 120 but not HD 42 (docs/fe-alternatives.md, \"A deeper cam\"). ")

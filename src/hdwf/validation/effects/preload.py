@@ -14,7 +14,7 @@ EFFECT = Effect(
         "relieves that preload, and play opens only once it is used up. The baseline section "
         "has none (the teeth just touch at zero offsets). In the FE model each FS flank is "
         "thickened along its normal by interference_m times the module, the tips relieved as "
-        "the preload needs and their corners rounded, and the wave generator is mounted on a preload ramp "
+        "the preload needs, and the wave generator is mounted on a preload ramp "
         "(docs/fe-model.md, 'Preloaded engagement'). A design value: offered only where a "
         "campaign names it."),
     signature="the dead band shrinks and closes once the preload takes the clearance up; "
