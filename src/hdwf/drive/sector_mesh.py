@@ -212,6 +212,7 @@ def _rim_size_field(prof: RingProfile, sizes: RingSizes, rounds: list[int]) -> N
 
 
 def _curve_length(curve: int) -> float:
+    """Length (mm) of a gmsh curve, from 21 points along its parametrisation."""
     lo, hi = gmsh.model.getParametrizationBounds(1, curve)
     ts = np.linspace(lo[0], hi[0], 21)
     xyz = np.array(gmsh.model.getValue(1, curve, ts)).reshape(-1, 3)
