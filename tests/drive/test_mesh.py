@@ -85,3 +85,21 @@ def test_review_file_holds_every_body_and_group(geom, tmp_path):
                      "ir_bore", "ir_race", "or_race", "or_outer"}
     assert n_nodes == m.n_nodes
     assert n_tri == sum(b.mesh.t.shape[1] for b in m.bodies.values())
+
+
+def test_flank_refinement_divides_only_the_flanks(geom):
+    """``flank_refinement`` 2 doubles the segments of every flank (each a transfinite curve): the
+    teeth's boundary gains exactly 2 flanks x n_flank edges per tooth, the tip lands, roots and the
+    element size inside the teeth stay (the same sizes, only the flank's division changes)."""
+    plain = build_mesh(geom, **COARSE, symmetry="half", bodies=("fs", "cs"))
+    finer = build_mesh(geom, **COARSE, symmetry="half", bodies=("fs", "cs"), flank_refinement=2.0)
+    n = plain.sizes["n_flank"]
+    assert finer.sizes["n_flank"] == 2 * n
+    assert {k: v for k, v in finer.sizes.items() if k != "n_flank"} == \
+        {k: v for k, v in plain.sizes.items() if k != "n_flank"}
+    for name, z in (("fs", geom.z_fs), ("cs", geom.z_cs)):
+        added = finer.bodies[name].edge_sets[f"{name}_teeth"].shape[0] - \
+            plain.bodies[name].edge_sets[f"{name}_teeth"].shape[0]
+        assert added == (z // 2) * 2 * n
+    with pytest.raises(ValueError, match="flank_refinement"):
+        build_mesh(geom, **COARSE, symmetry="half", bodies=("fs",), flank_refinement=0.0)

@@ -22,19 +22,21 @@ class MeshSettings:
 
     ``elements_over_height`` and ``elements_over_thickness`` are counts over a tooth (the
     paper's rule is 10 and 6); ``refinement`` multiplies both; ``symmetry`` is ``"full"`` or
-    ``"half"`` (the half section with its cut tied, see ``docs/fe-model.md``).
+    ``"half"`` (the half section with its cut tied, see ``docs/fe-model.md``);
+    ``flank_refinement`` multiplies the segments along every flank only (``build_mesh``).
     """
 
     elements_over_height: int = 10
     elements_over_thickness: int = 6
     refinement: float = 1.0
     symmetry: str = "full"
+    flank_refinement: float = 1.0
 
     @classmethod
     def from_mapping(cls, settings: Mapping) -> "MeshSettings":
         """Settings from a config-style mapping; keys it does not name keep their defaults."""
         known = {k: settings[k] for k in ("elements_over_height", "elements_over_thickness", "refinement",
-                                          "symmetry") if k in settings}
+                                          "symmetry", "flank_refinement") if k in settings}
         return cls(**known)
 
     def as_dict(self) -> dict:
@@ -43,7 +45,7 @@ class MeshSettings:
     def mesh(self, geom: DriveGeometry, path: str | None = None, bodies: tuple[str, ...] = BODY_NAMES) -> DriveMesh:
         """Mesh ``geom`` (its ``bodies``); with ``path`` gmsh also writes its ``.msh`` there."""
         return build_mesh(geom, self.elements_over_height, self.elements_over_thickness, self.refinement,
-                          path=path, symmetry=self.symmetry, bodies=bodies)
+                          path=path, symmetry=self.symmetry, bodies=bodies, flank_refinement=self.flank_refinement)
 
 
 def design_parameters(designs_path, design_id: str) -> dict[str, float]:

@@ -76,14 +76,15 @@ class DriveMesh:
         return sum(b.mesh.p.shape[1] for b in self.bodies.values())
 
 
-def _sizes(g: DriveGeometry, n_h: int, n_t: int, refinement: float) -> dict[str, float]:
+def _sizes(g: DriveGeometry, n_h: int, n_t: int, refinement: float,
+           flank_refinement: float = 1.0) -> dict[str, float]:
     h_tooth = g.r_fs_tip - g.r_fs_root
     s_pitch = math.pi * g.module / 2
     nh = max(2, int(round(n_h * refinement)))
     nt = max(2, int(round(n_t * refinement)))
     s = min(h_tooth / nh, s_pitch / nt)
     return dict(
-        n_flank=nh,
+        n_flank=max(2, int(round(nh * flank_refinement))),
         tooth=s,
         fs_bore=2.0 * s,
         cs_outer=max(4.0 * s, (g.r_cs_outer - g.r_cs_root) / max(3.0, 4 * refinement)),
@@ -128,7 +129,7 @@ def _round_segments(s: dict) -> int:
 def build_mesh(geom: DriveGeometry, elements_over_height: int = 10,
                elements_over_thickness: int = 6, refinement: float = 1.0,
                path: str | None = None, symmetry: str = "full",
-               bodies: tuple[str, ...] = BODY_NAMES) -> DriveMesh:
+               bodies: tuple[str, ...] = BODY_NAMES, flank_refinement: float = 1.0) -> DriveMesh:
     """Mesh the four bodies (or some); write ``path`` (.msh) if given; return per-body meshes.
 
     Parameters
@@ -141,6 +142,9 @@ def build_mesh(geom: DriveGeometry, elements_over_height: int = 10,
         docstring); ``"full"`` (default) the whole drive.
     bodies : the bodies to mesh.  Each body is meshed on its own, so a body meshed alone is
         the same as in the whole drive (``share_bodies``).
+    flank_refinement : multiplies the segments along every flank only (on top of
+        ``refinement``; the element size inside the teeth stays): the flank contact needs a
+        finer division than the teeth's elasticity (``docs/fe-model.md``, Mesh convergence).
 
     Returns
     -------
@@ -155,7 +159,9 @@ def build_mesh(geom: DriveGeometry, elements_over_height: int = 10,
         raise ValueError(f"bodies must be some of {BODY_NAMES}, not {bodies!r}")
     if half and (g.z_fs % 2 or g.z_cs % 2 or g.n_balls % 2):
         raise ValueError("half model needs even tooth and ball counts (180 deg symmetry)")
-    s = _sizes(g, elements_over_height, elements_over_thickness, refinement)
+    if flank_refinement <= 0:
+        raise ValueError(f"flank_refinement must be positive, not {flank_refinement!r}")
+    s = _sizes(g, elements_over_height, elements_over_thickness, refinement, flank_refinement)
     gmsh.initialize(interruptible=False)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
