@@ -307,6 +307,17 @@ def test_ladder_is_held_against_the_bearing_rating():
     assert _bearing_sentence(lad.drop(columns=["specimens_checked"])) == ""
 
 
+def test_ladder_rungs_give_the_values_they_were_solved_with():
+    """A rung's values are read from the ladder's ``effects`` (the final calibration, not the
+    rounds' table estimates), each with its effect's unit, to four significant figures and never
+    in exponent notation; the baseline has none."""
+    from hdwf.report.document import lit
+    from hdwf.report.validation_part import _rung_values
+    assert _rung_values("{}") == "–"
+    said = _rung_values('{"preload": {"interference_m": 0.18595198}, "fs_cup_torsion": {"K_Nm_per_rad": 302833.88}}')
+    assert said == f"{lit('K_Nm_per_rad')} = 302800 N·m/rad; {lit('interference_m')} = 0.186 module"
+
+
 def test_rank_split_section_finds_the_rank_lost_on_the_flat_part(named_inputs, tmp_path):
     """Ours = the paper's Φ with the 13 designs of its flat part in reverse order: past the knee
     ρ is 1, on the flat part −1; the paper's own hinge ranks Table 4 at 0.910
@@ -340,3 +351,28 @@ def test_rank_split_section_finds_the_rank_lost_on_the_flat_part(named_inputs, t
     assert "it ranks worse on the flat part" in doc.blocks[-1]["text"]
     pdf = doc.compile(tmp_path / "ranks.pdf")
     assert "Where the rank is lost" in _pdf_text(pdf)
+
+
+def test_each_shipped_campaign_says_what_its_data_are_before_anything_else():
+    """The shipped campaigns are synthetic data and another model's results, not bench data: the
+    config says so for each (``about``), the plan carries it to ``diagnosis.json``, and the
+    campaign's chapter opens with it; a campaign without it opens with its measurements."""
+    import yaml
+
+    from hdwf.report.validation_part import _campaign_intro
+    from hdwf.stages.validation import campaign_plan
+
+    from conftest import ROOT
+
+    config = yaml.safe_load((ROOT / "config.yaml").read_text())
+    abouts = {name: campaign_plan(name, camp, config["fe"]).about for name, camp in config["validation"].items()}
+    assert "synthetic" in abouts["demo"] and "12 K" in abouts["demo"]
+    assert all("not bench data" in abouts[n] and "Ansys" in abouts[n] for n in ("paper_hd42", "paper_hd120"))
+    diag = {"measurements": "data/x.csv", "n_specimens": 3, "n_points": 3, "form": "lost_motion",
+            "noise_arcmin": None, "mesh": {"elements_over_height": 5, "elements_over_thickness": 3},
+            "model": {"fixed": {}}, "ranking": [{"effect": "thermal"}], "about": "synthetic, not bench data"}
+    doc = Document("t", "s", {})
+    _campaign_intro(doc, diag)
+    assert doc.blocks[-1]["text"].startswith("The data: synthetic, not bench data. Measurements: data/x.csv")
+    _campaign_intro(doc, {**diag, "about": ""})
+    assert doc.blocks[-1]["text"].startswith("Measurements: data/x.csv")

@@ -294,13 +294,13 @@ def measured_vs_predicted_figure(points: pd.DataFrame, title: str, path) -> None
     title, path
         The figure's title and PNG file.
     """
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), sharex=True, sharey=True)
+    # each panel its own range: the found effects' errors are often a twentieth of the model's
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.2))
     D = points["D"].to_numpy(float)
-    every = np.concatenate([D, points["S_model"].to_numpy(float), points["S_final"].to_numpy(float)])
-    lo, hi = np.nanmin(every), np.nanmax(every)
-    pad = 0.05 * (hi - lo or 1.0)
     for ax, col, name in zip(axes, ("S_model", "S_final"), ("campaign model", "with the found effects")):
         S = points[col].to_numpy(float)
+        lo, hi = np.nanmin(np.concatenate([D, S])), np.nanmax(np.concatenate([D, S]))
+        pad = 0.05 * (hi - lo or 1.0)
         rmse = float(np.sqrt(np.mean((S - D) ** 2)))
         ax.plot([lo - pad, hi + pad], [lo - pad, hi + pad], "k-", lw=0.8)
         ax.plot(S, D, "o", ms=3, alpha=0.6)
@@ -335,6 +335,8 @@ def residual_figure(points: pd.DataFrame, title: str, path) -> None:
         ax.plot(spec[col], spec["r1"], "x", label="with found effects")
         ax.axhline(0, color="k", lw=0.6)
         ax.set_xlabel(_label(p))
+        ax.ticklabel_format(axis="x", useOffset=False)
+        ax.tick_params(axis="x", labelrotation=30)
     axes[0].set_ylabel("mean residual D − S (arcmin)")
     if curve:
         ax = axes[-1]

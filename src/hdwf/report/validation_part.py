@@ -4,6 +4,9 @@ error ladder), all read from the campaign's ``diagnosis.json``, ladder and figur
 
 from __future__ import annotations
 
+import json
+
+import numpy as np
 import pandas as pd
 
 from hdwf.common.io import read_json
@@ -23,6 +26,19 @@ def _effect_sentence(r: dict) -> str:
     eff = get_effect(r["effect"])
     (pname, val), = r["params"].items()
     return f"*{lit(eff.title)}* ({lit(pname)} = {_estimate(val, r.get('param_sd'))} {lit(eff.param(pname).unit)})"
+
+
+def _significant(value: float, digits: int = 4) -> str:
+    """A calibrated value to ``digits`` significant figures, never in exponent notation."""
+    return np.format_float_positional(value, precision=digits, unique=False, fractional=False, trim="-")
+
+
+def _rung_values(effects_json: str) -> str:
+    """A ladder rung's effects as solved: each calibrated parameter with its unit."""
+    effects = json.loads(effects_json)
+    parts = [f"{lit(p)} = {_significant(v)} {lit(get_effect(e).param(p).unit)}"
+             for e, params in sorted(effects.items()) for p, v in params.items()]
+    return "; ".join(parts) if parts else "–"
 
 
 def _detectability_rows(candidates: list[dict]) -> list[list[str]]:
@@ -108,7 +124,8 @@ def refinement_notes(doc: Document, diag: dict) -> None:
 def _campaign_intro(doc: Document, diag: dict) -> None:
     """The measurements, the campaign's model and the candidates tried, in one paragraph."""
     noise = diag.get("noise_arcmin")
-    doc.text(f"Measurements: {lit(diag['measurements'])}, {diag['n_specimens']} specimens, {diag['n_points']} values "
+    about = f"The data: {lit(diag['about'])}. " if diag.get("about") else ""
+    doc.text(f"{about}Measurements: {lit(diag['measurements'])}, {diag['n_specimens']} specimens, {diag['n_points']} values "
              f"({lit(diag['form'])} form)"
              + (f", stated noise {fmt(noise, 4)} arcmin" if noise else ", no noise stated")
              + f". Model: our FE model on a mesh of {diag['mesh']['elements_over_height']} × "
@@ -136,7 +153,8 @@ def _where_it_fails(doc: Document, diag: dict, campaign: CampaignArtefacts, leve
                   "statsmodels tests: a small p-value is a pattern in the error that the model does not explain.")
     doc.figure(campaign.measured_png, "Measured against predicted: the campaign's model and the model with the found "
                "effects switched on (calibrated values; table interpolation).")
-    doc.figure(campaign.residuals_png, "Residuals D − S against each input (specimen means) and along the test.")
+    along = " and along the test" if diag["form"] == "curve" else ""
+    doc.figure(campaign.residuals_png, f"Residuals D − S against each input (specimen means){along}.")
 
 
 _TERM_LABELS = {"bias": "level bias", "slope": "slope on torque (compliance)",
@@ -277,11 +295,13 @@ def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2)
     refinement_notes(doc, diag)
     detectability_section(doc, diag, level + 1)
     doc.heading("Adding it: the error ladder", level + 1)
-    doc.table(["rung", "model", "RMSE", "bias", "largest |E|", "ΔBIC"],
-              [[str(r["rung"]), lit(r["model"]), fmt(r["rmse_arcmin"], 4), fmt(r["bias_arcmin"], 4),
-                fmt(r["max_abs_arcmin"], 4), fmt(r["delta_bic"], 1)] for r in ladder.to_dict("records")],
+    doc.table(["rung", "model", "values solved with", "RMSE", "bias", "largest |E|", "ΔBIC"],
+              [[str(r["rung"]), lit(r["model"]), _rung_values(r["effects"]), fmt(r["rmse_arcmin"], 4),
+                fmt(r["bias_arcmin"], 4), fmt(r["max_abs_arcmin"], 4), fmt(r["delta_bic"], 1)]
+               for r in ladder.to_dict("records")],
               "Each rung re-solved with the FE model (not interpolated): the found effects switched on at their "
-              "calibrated values. ΔBIC against the first rung."
+              "final calibrated values (after any recalibration on actual solves, so they and the RMSE can differ "
+              "from the rounds' table estimates above). ΔBIC against the first rung."
               + (f" Stated noise: {fmt(noise, 4)} arcmin." if noise else ""))
     bearing = _bearing_sentence(ladder)
     if bearing:

@@ -38,6 +38,7 @@ class CampaignPlan:
     rounds: int
     settings: dict         # mesh settings of its solves
     steps_per_ramp: int
+    about: str = ""        # what the measurements are, for the report
 
     def table_variants(self) -> list[dict]:
         """The variants every specimen's table holds (``hdwf.validation.variants.plan_variants``)."""
@@ -100,7 +101,7 @@ def campaign_plan(name: str, camp: dict, fe: dict) -> CampaignPlan:
                 "symmetry": fe.get("symmetry", "full")}
     return CampaignPlan(name, camp["unit"], camp["measurements"], fixed, calib, cands,
                         int(camp.get("rounds", 2)), settings,
-                        int(camp.get("steps_per_ramp", fe["steps_per_ramp"])))
+                        int(camp.get("steps_per_ramp", fe["steps_per_ramp"])), camp.get("about", ""))
 
 
 def campaign_specimens(plan: CampaignPlan) -> pd.DataFrame:
@@ -206,6 +207,7 @@ def diagnosis_stage(plan: CampaignPlan, inputs: CampaignInputs, out_json, out_po
     from hdwf.validation.diagnosis import diagnose
     diagnosis = diagnose(meas, table, plan.search(), solve=solve)
     result = json_safe({"campaign": plan.name, "unit": plan.unit, "measurements": str(inputs.measurements),
+                        "about": plan.about,
                         "mesh": plan.settings, **diagnosis.to_dict(), "provenance": provenance})
     write_parquet(diagnosis.points, out_points, provenance=provenance, meta={"campaign": plan.name, "unit": plan.unit})
     write_json(result, out_json)

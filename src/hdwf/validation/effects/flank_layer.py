@@ -18,7 +18,7 @@ EFFECT = Effect(
         "(docs/fe-model.md, 'A compliant flank layer'). A modelling value: offered only where a "
         "campaign names it."),
     signature="every engaged state softer, the more so the fewer teeth carry the torque",
-    parameters=(Parameter("thickness_m", "m", 0.0, 10000.0, 2000.0,
+    parameters=(Parameter("thickness_m", "module", 0.0, 10000.0, 2000.0,
                           "equivalent steel thickness of the layer, in units of the module m",
                           "linear", 4),),
     apply=lambda ch, thickness_m: replace(ch, flank_layer_m=thickness_m),

@@ -19,7 +19,7 @@ EFFECT = Effect(
         "campaign names it."),
     signature="the dead band shrinks and closes once the preload takes the clearance up; "
               "the elastic slopes stay",
-    parameters=(Parameter("interference_m", "m", 0.0, 0.3, 0.15,
+    parameters=(Parameter("interference_m", "module", 0.0, 0.3, 0.15,
                           "normal interference per FS flank, in units of the module m",
                           "linear", 6),),
     apply=lambda ch, interference_m: replace(ch, flank_interference_m=interference_m),
