@@ -376,3 +376,41 @@ def test_each_shipped_campaign_says_what_its_data_are_before_anything_else():
     assert doc.blocks[-1]["text"].startswith("The data: synthetic, not bench data. Measurements: data/x.csv")
     _campaign_intro(doc, {**diag, "about": ""})
     assert doc.blocks[-1]["text"].startswith("Measurements: data/x.csv")
+
+
+def test_a_round_verdict_names_a_paying_runner_up_and_the_evidence_between_them():
+    """The ΔBIC a verdict quotes is against the round's model; when another candidate pays too,
+    the verdict gives the gap between the two (Kass–Raftery's scale: 6–10 strong, above 10 very
+    strong), and says nothing when no other candidate pays."""
+    from hdwf.report.validation_part import _round_verdict
+
+    def cand(effect, dbic, pays=True):
+        return {"effect": effect, "params": {"K_Nm_per_rad": 2e4}, "rmse_arcmin": 0.25, "delta_bic": dbic,
+                "signature_match": 0.78, "signature": "a slope", "pays": pays}
+
+    rnd = {"round": 2, "current_rmse_arcmin": 0.41,
+           "verdict": {"missing_effect": "fs_cup_torsion", "indistinguishable_from": []},
+           "ranking": [cand("fs_cup_torsion", -22.2), cand("cs_housing", -14.1), cand("thermal", -3.0, False)]}
+    said = _round_verdict(rnd)
+    assert "The runner-up, cs" in said and "(ΔBIC -14.1)" in said and "is 8.1 lower, strong evidence" in said
+    rnd["ranking"][1]["delta_bic"] = -10.2
+    assert "is 12.0 lower, very strong evidence" in _round_verdict(rnd)
+    rnd["ranking"][1]["pays"] = False
+    assert "runner-up" not in _round_verdict(rnd)
+
+
+def test_an_effect_found_where_it_was_not_visible_is_flagged_with_both_values():
+    """A found effect that the detectability marks invisible at its realistic value was found
+    larger than realistic: the report gives the found and the realistic value; a visible or an
+    unfound one is not named."""
+    from hdwf.report.validation_part import _found_beyond_realistic
+    det = {"candidates": [
+        {"effect": "fs_cup_torsion", "param": "K_Nm_per_rad", "realistic": 60000.0, "unit": "N·m/rad", "visible": False},
+        {"effect": "cs_housing", "param": "k_N_per_mm2", "realistic": 5000.0, "unit": "N/mm²", "visible": False},
+        {"effect": "preload", "param": "interference_m", "realistic": 0.15, "unit": "module", "visible": True}]}
+    diag = {"final": {"effects": {"preload": {"interference_m": 0.2218},
+                                  "fs_cup_torsion": {"K_Nm_per_rad": 20115.6}}}}
+    said = _found_beyond_realistic(diag, det)
+    assert "= 20120 N·m/rad against a realistic 60000" in said
+    assert "housing" not in said and "preload" not in said
+    assert _found_beyond_realistic({"final": {"effects": {}}}, det) == ""

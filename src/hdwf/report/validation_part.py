@@ -55,6 +55,24 @@ def _detectability_rows(candidates: list[dict]) -> list[list[str]]:
     return rows
 
 
+def _found_beyond_realistic(diag: dict, det: dict) -> str:
+    """Found effects the data could not have shown at their realistic value: what was found is
+    larger than a realistic one, and the sentence gives both values."""
+    final = diag.get("final", {}).get("effects", {})
+    parts = []
+    for c in det["candidates"]:
+        value = final.get(c["effect"], {}).get(c["param"])
+        if c["visible"] or value is None:
+            continue
+        parts.append(f"{lit(c['effect'])} at {lit(c['param'])} = {_significant(value)} {lit(c['unit'])} "
+                     f"against a realistic {_significant(c['realistic'])}")
+    if not parts:
+        return ""
+    return ("Found although this data could not have shown it at a realistic value: " + "; ".join(parts)
+            + ". What was found is a larger effect than a realistic one, so it may stand in for more than "
+            "that effect.")
+
+
 def detectability_section(doc: Document, diag: dict, level: int) -> None:
     """Which candidates the campaign's data could have shown at all (``diagnosis.json``: detectability).
 
@@ -80,6 +98,9 @@ def detectability_section(doc: Document, diag: dict, level: int) -> None:
               "show: the largest noise at which it would still pay (ΔBIC ≤ −10); noise to calibrate: at which its "
               "parameter would come out within 15 % (two standard deviations). ΔBIC and sd: what this data would "
               "give if the effect were there at that value (linearised).")
+    found_beyond = _found_beyond_realistic(diag, det)
+    if found_beyond:
+        doc.text(found_beyond)
     hidden = [c for c in det["candidates"] if c["effect"] in diag["verdict"].get("could_not_see", [])]
     if hidden:
         doc.text("This data could not have shown these effects at realistic values, so its verdict says nothing "
@@ -247,9 +268,24 @@ def _round_verdict(rnd: dict) -> str:
     if ties:
         txt += (f" The data cannot tell it from {lit(', '.join(ties))}: their signatures coincide here, so the "
                 "choice between them needs another test (different torque levels, temperatures or parts).")
+    txt += _runner_up(rnd, best, ties)
     if best.get("at_bound"):
         txt += " Its best value sits on the bound of its range: treat it as a stand-in, not an explanation."
     return txt
+
+
+def _runner_up(rnd: dict, best: dict, ties: list) -> str:
+    """The next candidate that pays too, and how far its ΔBIC is from the found effect's: the
+    evidence for the choice between them, which the ΔBIC against the round's model does not say."""
+    others = [r for r in rnd["ranking"] if r["pays"] and r["effect"] != best["effect"] and r["effect"] not in ties]
+    if not others:
+        return ""
+    nxt = min(others, key=lambda r: r["delta_bic"])
+    gap = nxt["delta_bic"] - best["delta_bic"]
+    strength = "very strong" if gap > 10 else "strong" if gap > 6 else "positive"
+    return (f" The runner-up, {lit(nxt['effect'])}, pays too (ΔBIC {fmt(nxt['delta_bic'], 1)}); the found effect's "
+            f"ΔBIC is {fmt(gap, 1)} lower, {strength} evidence for it over the runner-up (BIC differences of 6–10 "
+            "are strong, above 10 very strong).")
 
 
 def _bearing_sentence(ladder: pd.DataFrame) -> str:
