@@ -141,7 +141,7 @@ _SOURCES: dict[str, tuple[str, str]] = {   # field -> (unit of the value, source
     "d1": ("mm", "paper Table 2: inner-ring raceway shoulder"),
     "D1": ("mm", "paper Table 2: outer-ring raceway shoulder"),
     "B": ("mm", "paper Table 2: bearing width"),
-    "module": ("mm", "background: FS bore = D and wall under the roots about 2 m"),
+    "module": ("mm", "background: FS bore = D and wall under the roots about 2 modules"),
     "tooth_height": ("mm", "paper, Conclusions"),
     "addendum_frac": ("–", "assumed: addendum 0.45 h, dedendum 0.55 h leave 0.1 h tip/root clearance"),
     "alpha_deg": ("°", "assumed: involute pressure angle 20° (standard)"),

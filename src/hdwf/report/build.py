@@ -14,7 +14,7 @@ from hdwf.report.paper_part import (comparison_section, correlation_section, des
                                     paper_part, sobol_section, surrogate_section)
 from hdwf.report.validation_part import validation_part
 
-_SUBTITLES = {"paper": "The statistics chain on the paper's own FEA tables (Tables 4 and 5)"}
+_SUBTITLES = {"paper": "The statistics chain on the paper's own FEA tables (its Tables 4 and 5)"}
 
 
 def study_report(study: StudyArtefacts, data_dir, provenance: dict, out) -> Path:

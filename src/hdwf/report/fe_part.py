@@ -364,7 +364,7 @@ def agreement_section(doc: Document, units: list[str], paper: StudyArtefacts, ou
                      f"{fmt(ratio.min(), 2)}–{fmt(ratio.max(), 2)}"])
     doc.table(["drive", "designs solved", "Spearman $rho$", "p", "$R^2$", "paper mean $Phi$", "our mean $Phi$",
                "median ratio ours/paper", "ratio range"], rows,
-              "Agreement of our $Phi$ with the paper's at the 27 design points of Tables 4/5 ($R^2$ of a linear fit).")
+              "Agreement of our $Phi$ with the paper's at the 27 design points of its Tables 4/5 ($R^2$ of a linear fit).")
     if scatter_rows:
         _scatter_table(doc, scatter_rows)
     path = tmp / "agreement.png"
@@ -418,7 +418,7 @@ def indices_vs_paper_section(doc: Document, units: list[str], data_dir, studies:
     pub = load_published(data_dir)
     doc.heading("Sensitivity: our FE studies beside the paper", level)
     for u in units:
-        heads = ["param.", "paper $S_i$", "paper $S_(T i)$"]
+        heads = ["param.", "published $S_i$", "published $S_(T i)$"]   # the study "paper" is ours on its data
         for study in studies:
             heads += [f"{lit(study.name)} $S_i$", f"{lit(study.name)} $S_(T i)$"]
         doc.table(heads, _indices_rows(pub, u, studies),

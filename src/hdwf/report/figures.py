@@ -44,7 +44,7 @@ def correlation_figure(designs: pd.DataFrame, corr: pd.DataFrame, title: str, pa
         The figure's title and PNG file.
     """
     y = designs["lost_motion_arcmin"].to_numpy(float)
-    fig, axes = plt.subplots(1, 5, figsize=(15, 3.2), sharey=True)
+    fig, axes = plt.subplots(1, 5, figsize=(15, 3.2), sharey=True, layout="constrained")
     for ax, p, col in zip(axes, PARAMETERS, PARAMETER_COLUMNS):
         x = designs[col].to_numpy(float)
         ok = np.isfinite(y)
@@ -81,7 +81,7 @@ def surrogate_figure(designs: pd.DataFrame, fitted: np.ndarray, title: str, path
         The figure's title and PNG file.
     """
     y = designs["lost_motion_arcmin"].to_numpy(float)
-    fig, axes = plt.subplots(1, 6, figsize=(17, 3.2))
+    fig, axes = plt.subplots(1, 6, figsize=(17, 3.2), layout="constrained")
     for ax, p, col in zip(axes, PARAMETERS, PARAMETER_COLUMNS):
         x = designs[col].to_numpy(float)
         ax.plot(x, y, "o", mfc="none", color="tab:blue", label="data")
@@ -116,7 +116,7 @@ def sobol_convergence_figure(sobol: pd.DataFrame, title: str, path) -> None:
     est = sobol[sobol["sampler"] != "exact"]
     styles = {"lhs": ":", "halton": "--", "sobol": "-"}
     colors = dict(zip(PARAMETERS, ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple"]))
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4), sharey=True)
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4), sharey=True, layout="constrained")
     for ax, idx in zip(axes, ["S1", "ST"]):
         for p in PARAMETERS:
             for sampler, sub in est[est["parameter"] == p].groupby("sampler"):
@@ -174,7 +174,7 @@ def agreement_figure(pairs: dict[str, tuple[np.ndarray, np.ndarray]], title: str
     title, path
         The figure's title and PNG file.
     """
-    fig, axes = plt.subplots(1, len(pairs), figsize=(5.2 * len(pairs), 4.2), squeeze=False)
+    fig, axes = plt.subplots(1, len(pairs), figsize=(5.2 * len(pairs), 4.2), squeeze=False, layout="constrained")
     for ax, (label, (paper, ours)) in zip(axes[0], pairs.items()):
         ok = np.isfinite(ours)
         ax.plot(paper[ok], ours[ok], "o", mfc="none")
@@ -204,7 +204,7 @@ def knee_figure(panels: dict[str, dict[str, tuple[np.ndarray, np.ndarray, HingeF
     title, path
         The figure's title and PNG file.
     """
-    fig, axes = plt.subplots(1, len(panels), figsize=(5.2 * len(panels), 4.2), squeeze=False)
+    fig, axes = plt.subplots(1, len(panels), figsize=(5.2 * len(panels), 4.2), squeeze=False, layout="constrained")
     for ax, (label, models) in zip(axes[0], panels.items()):
         for (name, (s, phi, fit)), colour in zip(models.items(), ("tab:blue", "tab:red")):
             ax.plot(s, phi, "o", mfc="none", color=colour, label=f"{name} (R² {fit.r2:.2f})")
@@ -295,7 +295,7 @@ def measured_vs_predicted_figure(points: pd.DataFrame, title: str, path) -> None
         The figure's title and PNG file.
     """
     # each panel its own range: the found effects' errors are often a twentieth of the model's
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4.2))
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), layout="constrained")
     D = points["D"].to_numpy(float)
     for ax, col, name in zip(axes, ("S_model", "S_final"), ("campaign model", "with the found effects")):
         S = points[col].to_numpy(float)
@@ -325,7 +325,7 @@ def residual_figure(points: pd.DataFrame, title: str, path) -> None:
     """
     curve = "torque_Nm" in points.columns and points["torque_Nm"].notna().any()
     ncol = len(PARAMETERS) + (1 if curve else 0)
-    fig, axes = plt.subplots(1, ncol, figsize=(3 * ncol, 3.2), sharey=True)
+    fig, axes = plt.subplots(1, ncol, figsize=(3 * ncol, 3.2), sharey=True, layout="constrained")
     r0 = points["D"] - points["S_model"]
     r1 = points["D"] - points["S_final"]
     spec = points.assign(r0=r0, r1=r1).groupby("specimen_id").agg(

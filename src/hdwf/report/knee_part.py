@@ -55,7 +55,7 @@ def knee_section(doc: Document, units: list[str], data_dir: Path, paper: StudyAr
     doc.table(["drive", "model", "floor $a$", "knee $s_0$ (µm)", "slope $b$ (arcmin/µm)", "weights $w_d, w_D, w_G$",
                "$R^2$", "least-squares $d Phi slash d r_\"FS\"$ (arcmin/µm)"], rows,
               "Hinge fits $Phi = a + b max(0, s - s_0)$, $s = r_\"FS\" + r_\"CS\" + w_d Delta d slash 2 + "
-              "w_D Delta D slash 2 + w_G Delta G_r slash 2$ (µm, $Delta$ from Table 3's nominal design, weights "
+              "w_D Delta D slash 2 + w_G Delta G_r slash 2$ (µm, $Delta$ from the paper's Table 3 nominal design, weights "
               "fitted per model), and the $r_\"FS\"$ coefficient of a linear fit in all five parameters (in "
               "brackets: ours over the paper's).")
     path = tmp / "knee.png"

@@ -98,10 +98,10 @@ def designs_section(doc: Document, study: StudyArtefacts, level: int = 1) -> Non
         Heading level of the section.
     """
     doc.heading("Designs", level)
-    doc.text("The paper's 27 design points per drive (Tables 4 and 5) with its Ansys FEA lost motion. Beside them, "
+    doc.text("The paper's 27 design points per drive (its Tables 4 and 5) with its Ansys FEA lost motion. Beside them, "
              "our own optimal Latin hypercube (scipy `LatinHypercube`, optimised for centered $L_2$ discrepancy, "
              "seeded), which later studies solve with our FE model; both are measured by the same space-filling "
-             "criteria in the unit cube of Table 3's bounds.")
+             "criteria in the unit cube of the paper's Table 3 bounds.")
     for drive in study.drives:
         lm = pd.read_parquet(drive.lost_motion)
         rows = [[lit(r.design_id), *[fmt(getattr(r, c), 7) for c in PARAMETER_COLUMNS], fmt(r.lost_motion_arcmin, 4)]
@@ -110,7 +110,7 @@ def designs_section(doc: Document, study: StudyArtefacts, level: int = 1) -> Non
                   f"{UNIT_NAMES[drive.unit]}: design points and lost motion ({len(lm)} designs).")
     rows = [row for drive in study.drives for row in _space_filling_rows(drive)]
     doc.table(["design", "centered $L_2$ discrepancy", "maximin distance", "max |r| between inputs"], rows,
-              "Space-filling criteria (unit cube of Table 3 bounds): lower discrepancy and correlation, larger "
+              "Space-filling criteria (unit cube of the paper's Table 3 bounds): lower discrepancy and correlation, larger "
               "distance are better.")
 
 
@@ -228,7 +228,7 @@ def _sobol_drive(doc: Document, drive: DriveArtefacts) -> None:
         doc.text(f"{name}: the Sobol'-sequence estimate at $N = {SOBOL_CHECK_N}$ differs from the exact indices "
                  f"by at most {fmt(err, 5)}.")
     doc.figure(drive.sobol_png, f"{name}: convergence of $S_i$ and $S_(T i)$ with $N$ "
-               "(dotted LHS, dashed Halton, solid Sobol'); thick pale lines are the exact values; cf. Figs. 13/14.")
+               "(dotted LHS, dashed Halton, solid Sobol'); thick pale lines are the exact values; cf. the paper's Figs. 13/14.")
 
 
 def sobol_section(doc: Document, study: StudyArtefacts, level: int = 1) -> None:
@@ -286,11 +286,11 @@ def comparison_section(doc: Document, study: StudyArtefacts, data_dir, level: in
     """
     pub = load_published(data_dir)
     doc.heading("Our figures against the paper's", level)
-    doc.text("Every statistic the paper publishes, recomputed here from its own Tables 4 and 5. Differences are "
+    doc.text("Every statistic the paper publishes, recomputed here from its own Tables 4 and 5 (the paper's numbering). Differences are "
              "ours minus the paper's. Sobol' indices depend on the input bounds, which the paper does not state: "
              f"ours use *{study.surrogate_bounds.replace('_', ' ')}* bounds (the span of the "
              "design points, so the surrogate is never integrated where it has no data); the last column gives "
-             "the exact indices over Table 3's bounds for comparison.")
+             "the exact indices over the paper's Table 3 bounds for comparison.")
     rows = []
     worst = {}
     for r in pub.itertuples():
@@ -301,7 +301,7 @@ def comparison_section(doc: Document, study: StudyArtefacts, data_dir, level: in
             worst[r.unit] = max(worst.get(r.unit, 0.0), abs(ours - r.value))
         rows.append([UNIT_NAMES[r.unit], what, math_label(r.parameter) if r.parameter else "", fmt(r.value),
                      fmt(ours), fmt(ours - r.value), other, lit(r.source)])
-    doc.table(["drive", "statistic", "param.", "paper", "ours", "difference", "ours, Table 3 bounds", "paper source"],
+    doc.table(["drive", "statistic", "param.", "paper", "ours", "difference", "ours, paper Table 3 bounds", "paper source"],
               rows, "Replication of the paper's published statistics.")
     if worst:
         doc.text("Largest difference of a Sobol' index from the paper's: " +
