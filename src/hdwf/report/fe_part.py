@@ -291,7 +291,11 @@ def _scatter_table(doc: Document, rows: list[list[str]]) -> None:
              "from the mesh changes measured on the same drive (the designs of the mesh-convergence study, default mesh against "
              "1.25× finer; Mesh convergence above) with a random sign, 2000 times (seeded). A target met in "
              "some draws and missed in others could be met or missed by mesh scatter of that size alone; the "
-             "verdict below gives the share of draws that meet each target missed, or met in fewer than 95 %.")
+             "verdict below gives the share of draws that meet each target missed, or met in fewer than 95 %. "
+             "The bands are a lower bound on what the mesh can do: the change at 1.25× understates the default "
+             "mesh's error (docs/fe-model.md, Mesh convergence: against meshes up to 3× finer the default mesh's "
+             "$Phi$ lies 1–12 % high on the eight designs measured), and an error common to all designs moves "
+             "the level, not the rank.")
     doc.table(["drive", "mesh change", "median ratio", "Spearman $rho$", "$R^2$",
                "$d Phi slash d r_\"FS\"$ ours/paper"], rows,
               "The agreement figures under the measured mesh scatter, 5–95 % of the draws (mesh change: median "
