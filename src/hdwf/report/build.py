@@ -76,8 +76,15 @@ def full_report(report: ReportInputs, out) -> Path:
                    report.provenance)
     doc.text("Part I reproduces the statistics of Majchrák et al. from their own FEA tables; Part II solves the same "
              "lost-motion test with our FE model, at our own optimal Latin hypercube (`fe`) and at the paper's design "
-             "points (`fe_at_paper`), and runs the same chain on it. Every number below was computed by the workflow "
-             "from the artefacts under `results/`.")
+             "points (`fe_at_paper`), and runs the same chain on it; Part III holds the model against measurement "
+             "files, finds which physical effect it misses and re-solves it with that effect. Every number below "
+             "was computed by the workflow from the artefacts under `results/`.")
+    doc.text("Symbols: the flexspline (FS) is twisted against the held circular spline (CS) to ±T, 4 % of the "
+             "rated torque $T_N$ (the paper's Table 1); $phi$ and $phi'$ are the twist magnitudes at +T and −T "
+             "and the lost motion is $Phi = phi + phi'$. The five inputs: $d$ and $D$, the bore and outside "
+             "diameter of the wave generator's (WG's) bearing; $G_r$, its radial clearance; $r_\"FS\"$ and "
+             "$r_\"CS\"$, the normal offsets that thin the FS teeth and widen the CS spaces. A module m is the "
+             "gear module (0.18 mm on HD 42, 0.514 mm on HD 120); a preload or layer given in m is in modules.")
     # Figures drawn here (not by a rule) live until the document is typeset.
     with tempfile.TemporaryDirectory(prefix="hdwf-figs-") as tmp:
         for study in report.paper_studies:
