@@ -53,6 +53,29 @@ def test_lost_motion_schema_units_and_provenance(tmp_path, paper_dir):
     assert (df["status"] == "published").all()
 
 
+def test_provenance_names_the_library_checkout_when_it_is_not_the_projects(tmp_path):
+    """Run from a project whose checkout is not the one ``hdwf`` is imported from, the commit
+    names both (the project's alone would not say which code made the artefact); run from the
+    library's own checkout, just its commit."""
+    import subprocess
+
+    from hdwf.common import provenance as prov_module
+    library = prov_module._LIBRARY_ROOT
+    if not (library / ".git").exists():
+        pytest.skip("hdwf is not imported from a git checkout here")
+    project = tmp_path / "project"
+    project.mkdir()
+    git = ["git", "-C", str(project), "-c", "user.name=t", "-c", "user.email=t@t"]
+    subprocess.run(["git", "init", "-q", str(project)], check=True)
+    (project / "f").write_text("x")
+    subprocess.run(git + ["add", "f"], check=True)
+    subprocess.run(git + ["commit", "-qm", "one"], check=True)
+    project_commit = prov_module.git_commit(project)
+    said = provenance({}, project)["git_commit"]
+    assert said == f"{project_commit}; hdwf library {prov_module.git_commit(library)}"
+    assert provenance({}, library)["git_commit"] == prov_module.git_commit(library)
+
+
 def test_failed_design_never_carries_a_number(tmp_path):
     df = pd.DataFrame({"design_id": ["a", "b"], "d_mm": [31.0, 31.0], "D_mm": [42.0, 42.0], "Gr_mm": [0.01, 0.01],
                        "rFS_mm": [0.0, 0.0], "rCS_mm": [0.0, 0.0], "lost_motion_arcmin": [0.5, 0.7],

@@ -42,11 +42,23 @@ def git_commit(repo_dir: str | Path = ".") -> str:
         return "unknown (not a git checkout)"
 
 
+# the checkout this library was imported from (src/hdwf/common/provenance.py -> its root)
+_LIBRARY_ROOT = Path(__file__).resolve().parents[3]
+
+
 def provenance(config: dict, repo_dir: str | Path = ".") -> dict:
-    """What every artefact records: config hash, git commit, Python and package versions."""
+    """What every artefact records: config hash, git commit, Python and package versions.
+
+    The commit is the project's (``repo_dir``); when the ``hdwf`` running is imported from
+    another checkout (an install from elsewhere), that checkout's commit is added, since the
+    project's alone would not say which code made the artefact.
+    """
+    commit = git_commit(repo_dir)
+    if _LIBRARY_ROOT != Path(repo_dir).resolve() and (_LIBRARY_ROOT / ".git").exists():
+        commit += f"; hdwf library {git_commit(_LIBRARY_ROOT)}"
     return {
         "config_hash": config_hash(config),
-        "git_commit": git_commit(repo_dir),
+        "git_commit": commit,
         "python": platform.python_version(),
         "packages": package_versions(),
     }
