@@ -414,3 +414,14 @@ def test_an_effect_found_where_it_was_not_visible_is_flagged_with_both_values():
     assert "= 20120 N·m/rad against a realistic 60000" in said
     assert "housing" not in said and "preload" not in said
     assert _found_beyond_realistic({"final": {"effects": {}}}, det) == ""
+
+
+def test_least_covered_input_is_the_narrowest_span_of_the_unit_cube():
+    """The HD 120 paper design leaves the top third of G_r's bounds empty (its discrepancy is 8×
+    HD 42's): the column says which input and which part of its range the points span."""
+    import numpy as np
+
+    from hdwf.report.document import math_label
+    from hdwf.report.paper_part import _least_covered
+    pts = np.array([[0.0, 0.05, 0.01, 0.0, 0.02], [1.0, 0.98, 0.64, 1.0, 0.97], [0.5, 0.5, 0.3, 0.5, 0.5]])
+    assert _least_covered(pts) == f"{math_label(PARAMETERS[2])}: 1–64 %"
