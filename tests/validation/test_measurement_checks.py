@@ -197,3 +197,24 @@ def test_a_torque_beyond_the_model_test_stops_before_any_solve(tmp_path):
     problems = schedule_problems(load_measurements(write_table(df, tmp_path)), 5)
     assert [p[:3] for p in problems] == [(3, "torque_Nm", pytest.approx(1.0176))]
     assert "beyond the campaign model's test torque ±0.96 N·m" in problems[0][3]
+
+
+def test_parquet_nulls_and_non_numeric_columns_are_refused_not_dropped_or_read_as_numbers(tmp_path):
+    """A Parquet null specimen id or drive is an empty one (not the text 'None', and the row is
+    not lost); a boolean twist column would read as 0 and 1 arcmin and a datetime torque as
+    nanoseconds: both are refused by column type, naming it."""
+    df = _curve().astype({"specimen_id": object, "unit": object})
+    df.loc[3, "specimen_id"] = None
+    df.loc[12, "unit"] = None
+    with pytest.raises(MeasurementError) as exc:
+        load_measurements(write_table(df, tmp_path, "m.parquet"))
+    msg = str(exc.value)
+    assert "m.parquet, row 4, field 'specimen_id', value '': empty specimen id" in msg
+    assert "m.parquet, row 13, field 'unit'" in msg and "unknown drive" in msg
+    typed = _curve().assign(twist_arcmin=lambda d: d["twist_arcmin"] > 0,
+                            torque_Nm=pd.Timestamp("2026-01-01") + pd.to_timedelta(np.arange(18), "s"))
+    with pytest.raises(MeasurementError) as exc:
+        load_measurements(write_table(typed, tmp_path, "t.parquet"))
+    msg = str(exc.value)
+    assert "field 'twist_arcmin', value 'bool': a column of bool, not numbers" in msg
+    assert "field 'torque_Nm', value 'datetime64" in msg and "not numbers" in msg

@@ -254,9 +254,15 @@ def _typed_data(raw: pd.DataFrame, form: str) -> tuple[pd.DataFrame, list[tuple]
     ucol = UNCERTAINTY_COLUMN[form]
     if ucol in raw.columns:
         numeric.append(ucol)
-    data = pd.DataFrame({"specimen_id": raw["specimen_id"].astype(str).str.strip(),
-                         "unit": raw["unit"].astype(str).str.strip().str.lower().str.replace(" ", "")})
+    # a null id or drive (a Parquet null) is an empty one, not the text "None" or "nan"
+    data = pd.DataFrame({"specimen_id": raw["specimen_id"].astype(str).str.strip().where(raw["specimen_id"].notna(), ""),
+                         "unit": raw["unit"].astype(str).str.strip().str.lower().str.replace(" ", "")
+                                 .where(raw["unit"].notna(), "")})
     for c in numeric:
+        if raw[c].dtype.kind in "bmM":   # booleans and times would read as numbers
+            problems.append((1, c, str(raw[c].dtype), f"a column of {raw[c].dtype}, not numbers"))
+            data[c] = np.nan
+            continue
         values = pd.to_numeric(raw[c], errors="coerce").astype(float)
         for i in np.flatnonzero(~np.isfinite(values.to_numpy())):
             problems.append((i + 1, c, raw[c].iloc[i], "not a finite number (empty, NaN or text)"))
