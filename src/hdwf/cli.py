@@ -10,7 +10,7 @@ import sys
 from pathlib import Path
 
 from hdwf import __version__
-from hdwf.common.errors import InputError
+from hdwf.common.errors import InputError, SolveFailed
 from hdwf.common.io import atomic_path
 from hdwf.common.provenance import config_hash, provenance
 from hdwf.config import SCHEMA_PATH, load_config
@@ -243,6 +243,9 @@ def main(argv=None) -> int:
     except InputError as exc:
         print(f"hdwf: error: {exc}", file=sys.stderr)
         return 2
+    except SolveFailed as exc:
+        print(f"hdwf: error: {exc} (nothing was written)", file=sys.stderr)
+        return 1
     except BrokenPipeError:
         # the reader went away (e.g. `hdwf effects | head`): stop quietly, as a Unix tool does
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

@@ -86,6 +86,23 @@ def test_synth_shows_progress_and_writes_the_test_cycle(tmp_path, capsys):
     assert "u_twist_arcmin" not in data and len(load_measurements(out).specimens) == 2
 
 
+def test_synth_whose_solve_fails_says_so_without_a_traceback_and_writes_nothing(tmp_path, capsys, monkeypatch):
+    """A solve that does not converge (as ``fe.cycle.failed_result`` reports it, here forced) is
+    an error line naming the specimen and the reason, exit 1, and no output file."""
+    import hdwf.validation.variants as variants
+    from hdwf.fe.cycle import failed_result
+
+    monkeypatch.setattr(variants, "solve_lost_motion_variants", lambda geom, mesh, steps, group, shared=None: [
+        failed_result(RuntimeError("contact did not converge in 200 iterations"), None, 0.0) for _ in group])
+    out = tmp_path / "bench.csv"
+    rc = main(["synth", "--unit", "hd42", "--designs", "1", "--seed", "1", "--noise-arcmin", "0",
+               "--elements-over-height", "4", "--elements-over-thickness", "2", "--jobs", "1", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert rc == 1 and not out.exists()
+    assert "hdwf: error: synthesis: the FE solve failed for specimen hd42-s001" in err and "Traceback" not in err
+    assert "did not converge in 200 iterations" in err and err.rstrip().endswith("(nothing was written)")
+
+
 DEMO = ROOT / "data" / "validation" / "demo_hd42.csv"
 
 

@@ -28,3 +28,8 @@ class InputError(ValueError):
 
 class ConfigError(InputError):
     """A configuration file that does not match the schema."""
+
+
+class SolveFailed(RuntimeError):
+    """A solve a result needs did not converge: the message says which and why, and no number
+    is written for it (the command line reports it without a traceback)."""

@@ -17,6 +17,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import pandas as pd
 
+from hdwf.common.errors import SolveFailed
 from hdwf.validation.calibration import Response, responses
 from hdwf.validation.effects import get as get_effect
 from hdwf.validation.variants import (SolveSetup, candidate_names, mean_lost_motion, plan_variants,
@@ -134,7 +135,7 @@ def detectability_of_tables(table: pd.DataFrame, unit: str, noise_arcmin: float,
     base = table[table["variant"] == variant_key({})]
     bad = base[base["status"] != "ok"]
     if len(bad):
-        raise RuntimeError(f"the baseline solve failed for specimen {bad['specimen_id'].iloc[0]}: "
+        raise SolveFailed(f"the baseline solve failed for specimen {bad['specimen_id'].iloc[0]}: "
                            f"{bad['status'].iloc[0]}")
     obs = base[["specimen_id", "step", "torque_Nm"]].reset_index(drop=True)
     obs["quantity"] = "twist"

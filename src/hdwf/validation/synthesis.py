@@ -16,6 +16,7 @@ import pandas as pd
 from scipy.stats import qmc
 
 from hdwf import PARAMETER_COLUMNS, PARAMETERS
+from hdwf.common.errors import SolveFailed
 from hdwf.validation.effects import model_changes
 from hdwf.validation.measurements import TABLE3_BOUNDS, supported_bounds
 from hdwf.validation.variants import SolveSetup, specimen_solver
@@ -163,7 +164,7 @@ def synth_curves(setup: SolveSetup, n_designs: int, seed: int,
 
     Raises
     ------
-    RuntimeError
+    SolveFailed
         When the solve of a specimen fails (no silent rows).
     """
     specimens = synth_designs(setup.unit, n_designs, seed, ranges)
@@ -172,7 +173,7 @@ def synth_curves(setup: SolveSetup, n_designs: int, seed: int,
     table = specimen_solver(setup, specimens)([effects])
     bad = table[table["status"] != "ok"]
     if len(bad):
-        raise RuntimeError(f"synthesis: the FE solve failed for specimen "
+        raise SolveFailed(f"synthesis: the FE solve failed for specimen "
                            f"{bad['specimen_id'].iloc[0]}: {bad['status'].iloc[0]}")
     return specimens.merge(table[["specimen_id", "step", "torque_Nm", "twist_arcmin"]], on="specimen_id")
 
@@ -226,7 +227,7 @@ def synthesize(setup: SolveSetup, n_designs: int, seed: int, noise_arcmin: float
     ------
     ValueError
         For a negative or non-finite noise, bad ranges or effects.
-    RuntimeError
+    SolveFailed
         When a solve fails.
     """
     if noise_arcmin < 0 or not math.isfinite(noise_arcmin):
