@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import math
 import os
 import sys
 from pathlib import Path
@@ -68,11 +69,26 @@ def _solve_setup(args) -> SolveSetup:
     return SolveSetup(args.unit, mesh, args.steps_per_ramp, args.jobs, progress=True)
 
 
+def _bounded(kind: type, low: float, high: float, low_open: bool = False):
+    """An argparse type: a finite ``kind`` within [low, high] (low excluded if ``low_open``), the
+    same limits the config schema sets, refused with the value named."""
+    def parse(text: str):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not {'a whole number' if kind is int else 'a number'}")
+        if not math.isfinite(value) or value < low or (low_open and value == low) or value > high:
+            span = f"{'(' if low_open else '['}{kind(low)}, {kind(high)}]"
+            raise argparse.ArgumentTypeError(f"{text!r} is outside {span}")
+        return value
+    return parse
+
+
 def _specimen_options(p, seed_help: str, noise_help: str) -> None:
     p.add_argument("--unit", required=True, choices=["hd42", "hd120"])
-    p.add_argument("--designs", type=int, required=True, help="number of specimens")
-    p.add_argument("--seed", type=int, required=True, help=seed_help)
-    p.add_argument("--noise-arcmin", type=float, required=True, help=noise_help)
+    p.add_argument("--designs", type=_bounded(int, 1, 1000), required=True, help="number of specimens")
+    p.add_argument("--seed", type=_bounded(int, 0, 2 ** 32 - 1), required=True, help=seed_help)
+    p.add_argument("--noise-arcmin", type=_bounded(float, 0, 60), required=True, help=noise_help)
     p.add_argument("--range", action="append", default=[], metavar="NAME=LOW:HIGH",
                    help="sample this parameter over LOW..HIGH instead of the paper's Table 3 range, e.g. "
                         "rFS_mm=0:0.002 for a batch of accuracy-grade drives (repeatable)")
@@ -94,11 +110,11 @@ def _design_ranges(args) -> dict[str, tuple[float, float]]:
 
 
 def _solve_options(p, elements_over_height: int, elements_over_thickness: int) -> None:
-    p.add_argument("--elements-over-height", type=int, default=elements_over_height)
-    p.add_argument("--elements-over-thickness", type=int, default=elements_over_thickness)
-    p.add_argument("--refinement", type=float, default=1.0)
-    p.add_argument("--steps-per-ramp", type=int, default=5)
-    p.add_argument("--jobs", type=int, default=1, help="processes (one specimen each)")
+    p.add_argument("--elements-over-height", type=_bounded(int, 2, 40), default=elements_over_height)
+    p.add_argument("--elements-over-thickness", type=_bounded(int, 2, 30), default=elements_over_thickness)
+    p.add_argument("--refinement", type=_bounded(float, 0, 4, low_open=True), default=1.0)
+    p.add_argument("--steps-per-ramp", type=_bounded(int, 1, 50), default=5)
+    p.add_argument("--jobs", type=_bounded(int, 1, 256), default=1, help="processes (one specimen each)")
 
 
 def _synth(args) -> int:

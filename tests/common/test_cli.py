@@ -103,6 +103,26 @@ def test_synth_whose_solve_fails_says_so_without_a_traceback_and_writes_nothing(
     assert "did not converge in 200 iterations" in err and err.rstrip().endswith("(nothing was written)")
 
 
+@pytest.mark.parametrize("option, value, said", [
+    ("--designs", "0", "'0' is outside [1, 1000]"), ("--seed", "-1", "'-1' is outside [0, 4294967295]"),
+    ("--noise-arcmin", "inf", "'inf' is outside [0.0, 60.0]"), ("--refinement", "nan", "'nan' is outside (0.0, 4.0]"),
+    ("--steps-per-ramp", "0", "'0' is outside [1, 50]"), ("--elements-over-height", "1", "'1' is outside [2, 40]"),
+    ("--jobs", "0", "'0' is outside [1, 256]"), ("--designs", "two", "'two' is not a whole number")])
+def test_synth_and_plan_refuse_options_outside_the_schemas_limits_before_any_solve(tmp_path, capsys, option, value, said):
+    """The mesh and load options carry the config schema's limits (a mesh of 0 elements was
+    silently clamped, 0 steps wrote a file the loader refuses, 0 designs died in pandas): the
+    option and value are named, exit 2, nothing written."""
+    base = {"--designs": "2", "--seed": "1", "--noise-arcmin": "0.05"}
+    for command in ("synth", "plan"):
+        args = {**base, option: value}
+        argv = [command, "--unit", "hd42", *[x for kv in args.items() for x in kv]]
+        out = tmp_path / "x.csv"
+        with pytest.raises(SystemExit) as exc:
+            main(argv + (["--out", str(out)] if command == "synth" else []))
+        assert exc.value.code == 2 and not out.exists()
+        assert f"argument {option}: {said}" in capsys.readouterr().err
+
+
 DEMO = ROOT / "data" / "validation" / "demo_hd42.csv"
 
 
