@@ -7,6 +7,7 @@ reads the file, the dotted key path, the value and what was expected.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import jsonschema
@@ -75,7 +76,22 @@ def blame(sources: list[str | Path], field: str, value=None) -> str:
     return "--config (command line)"
 
 
+def _not_a_number(value, path: str = "") -> str | None:
+    """The key path of the first NaN in a config (YAML's .nan passes every bound of a schema)."""
+    if isinstance(value, float) and math.isnan(value):
+        return path or "(top level)"
+    items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
+    for key, sub in items:
+        found = _not_a_number(sub, f"{path}.{key}" if path else str(key))
+        if found:
+            return found
+    return None
+
+
 def _check_schema(config: dict, schema_path: str | Path, source) -> None:
+    nan_at = _not_a_number(config)
+    if nan_at:
+        raise ConfigError(source, "not a number (NaN): give a value", field=nan_at, value=float("nan"))
     schema = yaml.safe_load(Path(schema_path).read_text())
     validator_cls = jsonschema.validators.validator_for(schema)
     # Fill defaults so downstream code never meets a missing optional key.

@@ -40,6 +40,9 @@ def test_shipped_config_is_valid():
     (lambda c: c["fe"].update(effects={"preload": {"interference_m": 0.5}}),                          # out of bounds
      "fe.effects.preload.interference_m", 0.5),
     (lambda c: c["fe"].update(effects={"preload": {"delta": 0.1}}), "fe.effects.preload.delta", "delta"),
+    (lambda c: c["sobol"].update(tolerance=float("nan")), "sobol.tolerance", float("nan")),   # .nan passes bounds
+    (lambda c: c["validation"]["demo"]["mesh"].update(refinement=float("nan")),
+     "validation.demo.mesh.refinement", float("nan")),
 ])
 def test_bad_config_names_file_field_and_value(tmp_path, edit, field, value):
     path = _config_with(tmp_path, edit)
