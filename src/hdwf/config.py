@@ -76,6 +76,17 @@ def blame(sources: list[str | Path], field: str, value=None) -> str:
     return "--config (command line)"
 
 
+PAPER_SETS = 27   # design points of the paper's Tables 4 and 5
+
+
+def design_ids(config: dict, study: str, unit: str) -> list[str]:
+    """The design ids of a study's drive, known from the config alone: the paper's sets
+    (``paper-01`` …) or our Latin hypercube's (``hd42-lhs-01`` …, ``hdwf.stages.doe``)."""
+    if config["studies"][study].get("designs", "paper") == "paper":
+        return [f"paper-{i:02d}" for i in range(1, PAPER_SETS + 1)]
+    return [f"{unit}-lhs-{i:02d}" for i in range(1, config["doe"]["n_designs"] + 1)]
+
+
 def _not_a_number(value, path: str = "") -> str | None:
     """The key path of the first NaN in a config (YAML's .nan passes every bound of a schema)."""
     if isinstance(value, float) and math.isnan(value):
@@ -129,6 +140,14 @@ def _check_relations(config: dict, source) -> None:
             study = fe.get(key, {}).get("study")
             if study is not None and (study not in config["studies"] or config["studies"][study]["source"] != "fe"):
                 raise ConfigError(source, "must name an fe study", field=f"fe.{key}.study", value=study)
+        picture = fe.get("picture", {})
+        if "design" in picture and "study" in picture:
+            units = config["studies"][picture["study"]]["units"]
+            missing = [u for u in units if picture["design"] not in design_ids(config, picture["study"], u)]
+            if missing:
+                raise ConfigError(source, f"no such design of study '{picture['study']}' for {', '.join(missing)} "
+                                  f"(e.g. {design_ids(config, picture['study'], missing[0])[0]})",
+                                  field="fe.picture.design", value=picture["design"])
     for name, study in config.get("studies", {}).items():
         if study["source"] == "paper" and study.get("designs", "paper") != "paper":
             raise ConfigError(source, "a paper study uses the paper's designs", field=f"studies.{name}.designs",

@@ -40,6 +40,8 @@ def test_shipped_config_is_valid():
     (lambda c: c["fe"].update(effects={"preload": {"interference_m": 0.5}}),                          # out of bounds
      "fe.effects.preload.interference_m", 0.5),
     (lambda c: c["fe"].update(effects={"preload": {"delta": 0.1}}), "fe.effects.preload.delta", "delta"),
+    (lambda c: c["fe"]["picture"].update(design="paper-99"), "fe.picture.design", "paper-99"),  # failed at run time
+    (lambda c: c["fe"]["picture"].update(study="fe", design="hd42-lhs-01"), "fe.picture.design", "hd42-lhs-01"),
     (lambda c: c["sobol"].update(tolerance=float("nan")), "sobol.tolerance", float("nan")),   # .nan passes bounds
     (lambda c: c["validation"]["demo"]["mesh"].update(refinement=float("nan")),
      "validation.demo.mesh.refinement", float("nan")),

@@ -3,6 +3,7 @@
 
 import dataclasses
 
+from hdwf.config import design_ids as config_design_ids
 from hdwf.stages.validation import campaign_plan, campaign_specimens, specimen_record
 from hdwf.study.paper import FEA_TABLES, PAPER_TABLES
 
@@ -27,9 +28,7 @@ def study_units(study):
 
 def design_ids(study, unit):
     """Design ids are known from the config alone, so no checkpoint is needed."""
-    if STUDIES[study].get("designs", "paper") == "paper":
-        return [f"paper-{i:02d}" for i in range(1, 28)]
-    return [f"{unit}-lhs-{i:02d}" for i in range(1, config["doe"]["n_designs"] + 1)]
+    return config_design_ids(config, study, unit)
 
 
 def _alternatives(names):
