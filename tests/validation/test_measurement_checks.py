@@ -218,3 +218,19 @@ def test_parquet_nulls_and_non_numeric_columns_are_refused_not_dropped_or_read_a
     msg = str(exc.value)
     assert "field 'twist_arcmin', value 'bool': a column of bool, not numbers" in msg
     assert "field 'torque_Nm', value 'datetime64" in msg and "not numbers" in msg
+
+
+def test_an_empty_parameter_cell_is_one_problem_and_a_changed_one_names_the_plain_value(tmp_path):
+    """An empty cell is reported once (not also as the specimen 'changing' that parameter, as
+    it was even for a one-row specimen), and a real change quotes the first row's value as a
+    number, not as np.float64(...)."""
+    df = _curve()
+    df["Gr_mm"] = df["Gr_mm"].astype(object)
+    df.loc[6, "Gr_mm"] = ""          # row 7 of S1: empty
+    df.loc[7, "Gr_mm"] = 0.013       # row 8 of S1: another value
+    with pytest.raises(MeasurementError) as exc:
+        load_measurements(write_table(df, tmp_path))
+    lines = [l for l in str(exc.value).splitlines() if "Gr_mm" in l]
+    assert len(lines) == 2, lines
+    assert "row 7, field 'Gr_mm'" in lines[0] and "not a finite number" in lines[0]
+    assert "row 8, field 'Gr_mm', value 0.013: specimen 'S1' changes Gr_mm between rows (row 1 has 0.012)" in lines[1]

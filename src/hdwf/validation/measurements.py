@@ -335,12 +335,16 @@ def _check_specimens(data: pd.DataFrame, form: str) -> list[tuple]:
     lost_motion) or a well-formed curve."""
     problems = []
     for sid, rows in data.groupby("specimen_id", sort=False):
-        first = rows.index[0]
         for c in ["unit", *PARAMETER_COLUMNS]:
-            differs = rows.index[rows[c].astype(str) != str(rows[c].iloc[0])]
-            for i in differs:
+            # empty and NaN cells are reported already: compare the given values only
+            given = rows[c][rows[c].notna() & (rows[c].astype(str) != "")]
+            if given.empty:
+                continue
+            ref = given.iloc[0]
+            ref = ref.item() if hasattr(ref, "item") else ref
+            for i in given.index[given.astype(str) != str(ref)]:
                 problems.append((i + 1, c, data.at[i, c], f"specimen '{sid}' changes {c} between rows "
-                                                          f"(row {first + 1} has {rows[c].iloc[0]!r})"))
+                                                          f"(row {given.index[0] + 1} has {ref!r})"))
         if form == "curve":
             problems += _curve_problems(data, sid, rows)
         else:
