@@ -20,7 +20,7 @@ from hdwf.study.paper import paper_measurements
 from hdwf.validation.detectability import plan_detectability
 from hdwf.validation.effects import parse_assignment, registry
 from hdwf.validation.jsonsafe import json_safe
-from hdwf.validation.measurements import MeasurementError, load_measurements
+from hdwf.validation.measurements import MeasurementError, load_measurements, schedule_problems
 from hdwf.validation.synthesis import design_ranges, format_ranges, parse_range, synth_designs, synthesize
 from hdwf.validation.variants import SolveSetup
 
@@ -199,6 +199,9 @@ def _check_measurements(args) -> int:
     # every problem on a line of its own, and exit 1: the file is wrong, not the command (that is 2)
     try:
         m = load_measurements(args.file, unit=args.unit)
+        problems = schedule_problems(m, args.steps_per_ramp)
+        if problems:
+            raise MeasurementError(args.file, problems)
     except MeasurementError as exc:
         _print_problems(exc)
         return 1
@@ -229,6 +232,9 @@ def main(argv=None) -> int:
                                    "problem and exits 1, or a summary and exits 0.")
     p.add_argument("file", help="a .csv or .parquet measurement file")
     p.add_argument("--unit", required=True, choices=["hd42", "hd120"], help="the drive the file is for")
+    p.add_argument("--steps-per-ramp", type=_bounded(int, 1, 50), default=5,
+                   help="the campaign's load steps per ramp: a curve point beyond its test torque by more than "
+                        "a quarter of a step is refused (default 5, the config's)")
     p.set_defaults(func=_check_measurements)
     p = sub.add_parser("effects", help="list the candidate physical effects and their parameters")
     p.set_defaults(func=_effects)

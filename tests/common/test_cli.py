@@ -132,6 +132,20 @@ def test_check_measurements_of_a_good_file(capsys):
     assert out.out.strip() == f"{DEMO}: 16 specimens, 336 points, form curve: ok" and not out.err
 
 
+def test_check_measurements_refuses_a_point_beyond_the_campaigns_test_torque(tmp_path, capsys):
+    """The loader accepts a torque up to 1.5 T, a campaign only up to a quarter step beyond T:
+    the command checks as the campaign would (its steps per ramp, default 5), or said 'ok' to a
+    file the workflow then refused."""
+    data = pd.read_csv(DEMO)
+    data.loc[data["step"] == 5, "torque_Nm"] = 1.0176          # the demo's +T steps (0.96 N m) pushed past it
+    path = tmp_path / "beyond.csv"
+    data.to_csv(path, index=False)
+    assert main(["check-measurements", str(path), "--unit", "hd42"]) == 1
+    err = capsys.readouterr().err
+    assert "field 'torque_Nm', value 1.0176: beyond the campaign model's test torque" in err and "steps_per_ramp 5" in err
+    assert main(["check-measurements", str(path), "--unit", "hd42", "--steps-per-ramp", "1"]) == 0
+
+
 def test_check_measurements_prints_every_problem_and_exits_1(tmp_path, capsys):
     data = pd.read_csv(DEMO)
     data["u_twist_arcmin"] = data["u_twist_arcmin"].astype(float)
