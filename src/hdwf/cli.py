@@ -160,6 +160,8 @@ def _effects(args) -> int:
 def _plan(args) -> int:
     out = Path(args.out) if args.out else None
     if out is not None:
+        if out.suffix.lower() != ".json":
+            raise InputError(out, f"the plan is JSON: name the file .json, not '{out.suffix}'", field="--out")
         _refuse_existing(out, args)
     ranges = _design_ranges(args)
     try:

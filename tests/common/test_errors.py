@@ -129,6 +129,11 @@ def test_plan_command_refuses_bad_input_before_solving(tmp_path, capsys):
     rc = main(["plan", "--unit", "hd42", "--designs", "3", "--seed", "1", "--noise-arcmin", "0"])
     err = capsys.readouterr().err
     assert rc == 2 and err.strip() == "hdwf: error: command line: noise_arcmin must be > 0, got 0.0"
+    csv = tmp_path / "plan.csv"     # the plan is JSON: a .csv of JSON would mislead whoever opens it
+    rc = main(["plan", "--unit", "hd42", "--designs", "3", "--seed", "1", "--noise-arcmin", "0.05", "--out", str(csv)])
+    assert rc == 2 and not csv.exists()
+    assert capsys.readouterr().err.strip() == (f"hdwf: error: {csv}, field '--out': the plan is JSON: "
+                                               "name the file .json, not '.csv'")
 
 
 @pytest.mark.parametrize("text, says", [
