@@ -16,7 +16,7 @@ from hdwf.common.io import atomic_path
 from hdwf.common.provenance import config_hash, provenance
 from hdwf.config import SCHEMA_PATH, load_config
 from hdwf.stages.validation import campaign_plan, campaign_specimens
-from hdwf.study.paper import paper_measurements
+from hdwf.study.paper import PAPER_TABLES, paper_measurements
 from hdwf.validation.detectability import plan_detectability
 from hdwf.validation.effects import parse_assignment, registry
 from hdwf.validation.jsonsafe import json_safe
@@ -46,6 +46,16 @@ def _check_config(args) -> int:
             _print_problems(exc, f"campaign '{name}': ")
             continue
         print(f"campaign '{name}': {plan.measurements}: {len(specimens)} specimens of {plan.unit}: ok")
+    # the studies and the report read the paper's tables: a wrong folder fails only at run time
+    missing = [table for table in PAPER_TABLES if not (root / config["paper_data"] / table).is_file()]
+    if missing:
+        failed = True
+        error = InputError(args.config, f"no {', '.join(missing)} in that folder (relative to the config's "
+                                        "folder; the paper's tables, which the studies and the report read)",
+                           field="paper_data", value=config["paper_data"])
+        print(f"hdwf: error: {error}", file=sys.stderr)
+    else:
+        print(f"paper_data: {config['paper_data']}: the paper's {len(PAPER_TABLES)} tables: ok")
     return 1 if failed else 0
 
 
@@ -56,7 +66,9 @@ def _provenance(args) -> int:
 
 
 def _refuse_existing(out: Path, args, why: str = "") -> None:
-    """An existing output file is kept unless --force says otherwise."""
+    """An existing output file is kept unless --force says otherwise; a folder is never replaced."""
+    if out.is_dir():
+        raise InputError(out, "is a folder: name the output file", field="--out")
     if out.exists() and not args.force:
         raise InputError(out, f"exists; {why}use --force to replace it", field="--out")
 
@@ -129,6 +141,8 @@ def _synth(args) -> int:
             name, pname, value = parse_assignment(text)
         except (KeyError, ValueError) as exc:
             raise InputError("command line", str(exc).strip("'\""), field="--effect", value=text) from None
+        if pname in effects.get(name, {}):
+            raise InputError("command line", f"{name}:{pname} is given twice", field="--effect", value=text)
         effects.setdefault(name, {})[pname] = value
     try:
         data = synthesize(_solve_setup(args), args.designs, args.seed, args.noise_arcmin, effects, ranges)

@@ -188,6 +188,7 @@ def test_check_config_checks_every_campaign_file(tmp_path, capsys):
     (project / "config.yaml").write_text(config)
     for f in (ROOT / "data/validation").glob("*.csv"):
         (project / "data/validation" / f.name).write_bytes(f.read_bytes())
+    (project / "data/paper").symlink_to(ROOT / "data/paper")
     assert main(["check-config", str(project / "config.yaml")]) == 0
     out = capsys.readouterr().out
     assert "campaign 'demo': data/validation/demo_hd42.csv: 16 specimens of hd42: ok" in out
@@ -197,3 +198,19 @@ def test_check_config_checks_every_campaign_file(tmp_path, capsys):
     assert main(["check-config", str(project / "config.yaml")]) == 1
     err = capsys.readouterr().err
     assert "campaign 'demo'" in err and "row 5, field 'twist_arcmin', value -1000000000.0" in err
+
+
+def test_check_config_names_a_paper_data_folder_without_the_papers_tables(tmp_path, capsys):
+    """The studies and the report read the paper's tables from ``paper_data``: a missing folder
+    passed check-config and failed only when Snakemake planned the run."""
+    config = tmp_path / "config.yaml"
+    config.write_text((ROOT / "config.yaml").read_text())
+    (tmp_path / "data").mkdir()
+    (tmp_path / "data" / "validation").symlink_to(ROOT / "data" / "validation")
+    assert main(["check-config", str(config)]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"hdwf: error: {config}, field 'paper_data', value 'data/paper': "
+                                               "no table1_drives.csv, table2_bearings.csv"), err
+    (tmp_path / "data" / "paper").symlink_to(ROOT / "data" / "paper")
+    assert main(["check-config", str(config)]) == 0
+    assert "paper_data: data/paper: the paper's 6 tables: ok" in capsys.readouterr().out

@@ -160,3 +160,28 @@ def test_plan_refuses_a_design_range_given_twice(capsys):
                "--range", "rFS_mm=0:0.002", "--range", "rFS_mm=0:0.001"])
     err = capsys.readouterr().err
     assert rc == 2 and "field '--range', value 'rFS_mm=0:0.001'" in err and "twice" in err, err
+
+
+def test_synth_refuses_an_effect_parameter_given_twice(tmp_path, capsys):
+    """`--effect tooth_friction:mu=0.05 --effect tooth_friction:mu=0.08` kept the last value and
+    wrote a file whose hidden effect was not the one first typed."""
+    out = tmp_path / "m.csv"
+    rc = main(["synth", "--unit", "hd42", "--designs", "2", "--seed", "1", "--noise-arcmin", "0.01",
+               "--effect", "tooth_friction:mu=0.05", "--effect", "tooth_friction:mu=0.08", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert rc == 2 and not out.exists()
+    assert err.strip() == ("hdwf: error: command line, field '--effect', value 'tooth_friction:mu=0.08': "
+                           "tooth_friction:mu is given twice")
+
+
+@pytest.mark.parametrize("command", [["plan", "--unit", "hd42", "--designs", "2", "--seed", "1", "--noise-arcmin", "0.05"],
+                                     ["paper-measurements", "--unit", "hd42"]])
+def test_an_output_that_is_a_folder_is_refused_even_with_force(tmp_path, capsys, command):
+    """--out naming a folder with --force got as far as the rename (after every solve) and
+    failed there with a traceback; the folder and what is in it are kept."""
+    folder = tmp_path / "results.json"
+    folder.mkdir()
+    (folder / "keep").write_text("keep me")
+    rc = main([*command, "--out", str(folder), "--force"])
+    assert rc == 2 and (folder / "keep").read_text() == "keep me"
+    assert capsys.readouterr().err.strip() == f"hdwf: error: {folder}, field '--out': is a folder: name the output file"

@@ -234,3 +234,21 @@ def test_an_empty_parameter_cell_is_one_problem_and_a_changed_one_names_the_plai
     assert len(lines) == 2, lines
     assert "row 7, field 'Gr_mm'" in lines[0] and "not a finite number" in lines[0]
     assert "row 8, field 'Gr_mm', value 0.013: specimen 'S1' changes Gr_mm between rows (row 1 has 0.012)" in lines[1]
+
+
+@pytest.mark.parametrize("name", ["m.csv", "m.parquet"])
+def test_a_column_named_twice_is_refused_not_read_as_its_first(tmp_path, name):
+    """pandas reads a CSV's repeated column as 'twist_arcmin' and 'twist_arcmin.1' and the loader
+    used the first: a second reading (or a pasted block) was silently dropped. Both file types
+    name the column and the count."""
+    df = _curve()
+    df.insert(len(df.columns), "twist_dup", df["twist_arcmin"] + 1.0)
+    path = tmp_path / name
+    if name.endswith(".csv"):
+        df.to_csv(path, index=False, header=[*df.columns[:-1], "twist_arcmin"])
+    else:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+        pq.write_table(pa.Table.from_arrays([pa.array(df[c]) for c in df.columns],
+                                            names=[*df.columns[:-1], "twist_arcmin"]), path)
+    assert _refused(path) == [f"{path}, field 'twist_arcmin': the header names this column 2 times: keep one"]

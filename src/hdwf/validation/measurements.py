@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pyarrow as pa
+import pyarrow.parquet as pq
 
 from hdwf import PARAMETER_COLUMNS, PARAMETERS, UNITS
 from hdwf.common.errors import InputError
@@ -160,8 +161,10 @@ def _read_csv(path: Path, head: bytes) -> pd.DataFrame:
     # NUL never occurs in text; UTF-8 that decodes is not enough (binary can be valid ASCII)
     if b"\x00" in head:
         raise _unreadable(path, "cannot read the measurement file: not a text CSV file (it holds NUL bytes)")
+    read = dict(dtype=str, keep_default_na=False, skipinitialspace=True, encoding="utf-8")
     try:
-        return pd.read_csv(path, dtype=str, keep_default_na=False, skipinitialspace=True, encoding="utf-8")
+        data = pd.read_csv(path, **read)
+        header = pd.read_csv(path, header=None, nrows=1, **read).iloc[0].tolist()
     except UnicodeDecodeError:
         raise _unreadable(path, "cannot read the measurement file: not a text CSV file (not UTF-8; save it "
                                 "as UTF-8 text)") from None
@@ -169,15 +172,36 @@ def _read_csv(path: Path, head: bytes) -> pd.DataFrame:
         raise _unreadable(path, "cannot read the measurement file: empty file (no header line)") from None
     except pd.errors.ParserError as exc:
         raise _unreadable(path, f"cannot read the measurement file: malformed CSV: {exc}".strip()) from None
+    _refuse_repeated_columns(path, header)
+    return data
+
+
+def _refuse_repeated_columns(path: Path, names: list[str]) -> None:
+    # pandas renames a repeated CSV column ('twist_arcmin.1') and reads only the first: two columns
+    # of one name are two readings, and which one counts would be a guess
+    twice = sorted({name for name in names if names.count(name) > 1})
+    if twice:
+        raise MeasurementError(path, [(None, name, None, f"the header names this column {names.count(name)} times: "
+                                                         "keep one") for name in twice])
 
 
 def _read_parquet(path: Path) -> pd.DataFrame:
+    unreadable = (OSError, ValueError, pa.ArrowException)
+    try:
+        names = pq.read_schema(path).names
+    except unreadable as exc:
+        raise _not_parquet(path, exc) from None
+    _refuse_repeated_columns(path, names)
     try:
         return pd.read_parquet(path)
-    except (OSError, ValueError, pa.ArrowException) as exc:
-        # pyarrow repeats the path ("Could not open Parquet input source '...': why"): keep the why
-        why = str(exc).rsplit("': ", 1)[-1].strip()
-        raise _unreadable(path, f"cannot read the measurement file: not a Parquet file ({why})") from None
+    except unreadable as exc:
+        raise _not_parquet(path, exc) from None
+
+
+def _not_parquet(path: Path, exc: Exception) -> MeasurementError:
+    # pyarrow repeats the path ("Could not open Parquet input source '...': why"): keep the why
+    why = str(exc).rsplit("': ", 1)[-1].strip()
+    return _unreadable(path, f"cannot read the measurement file: not a Parquet file ({why})")
 
 
 def _form_of(columns) -> str | None:
