@@ -425,3 +425,28 @@ def test_least_covered_input_is_the_narrowest_span_of_the_unit_cube():
     from hdwf.report.paper_part import _least_covered
     pts = np.array([[0.0, 0.05, 0.01, 0.0, 0.02], [1.0, 0.98, 0.64, 1.0, 0.97], [0.5, 0.5, 0.3, 0.5, 0.5]])
     assert _least_covered(pts) == f"{math_label(PARAMETERS[2])}: 1–64 %"
+
+
+def test_the_ladder_figure_names_each_rungs_effect_and_shows_a_large_fall_on_a_log_axis(monkeypatch, tmp_path):
+    """The paper campaigns fall 46x and 31x: on a linear axis the last two rungs sat on the floor,
+    and the cumulative labels ('with preload, cup_torsion') overlapped. A fall beyond 10x (the
+    noise line included) is drawn on a log axis; each tick names the effect its rung adds."""
+    import matplotlib.pyplot as plt
+    import pandas as pd
+
+    from hdwf.report import figures
+
+    drawn = []
+    monkeypatch.setattr(figures, "_save", lambda fig, path: drawn.append(fig))
+    models = ["baseline", "with preload", "with preload, cup_torsion"]
+    figures.ladder_figure(pd.DataFrame({"model": models, "rmse_arcmin": [8.96, 0.52, 0.194]}), 0.19, "t", tmp_path / "a.png")
+    figures.ladder_figure(pd.DataFrame({"model": ["baseline", "campaign model", "with thermal"],
+                                        "rmse_arcmin": [0.31, 0.30, 0.052]}), 0.05, "t", tmp_path / "b.png")
+    steep, shallow = (fig.axes[0] for fig in drawn)
+    assert steep.get_yscale() == "log" and shallow.get_yscale() == "linear"     # 8.96/0.19 = 47; 0.31/0.05 = 6.2
+    assert [t.get_text() for t in steep.get_xticklabels()] == ["baseline", "+ preload", "+ cup_torsion"]
+    assert [t.get_text() for t in shallow.get_xticklabels()] == ["baseline", "campaign model", "+ thermal"]
+    low, high = steep.get_ylim()
+    assert low < 0.19 and high > 8.96                                           # every rung and the noise in view
+    for fig in drawn:
+        plt.close(fig)

@@ -9,6 +9,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 from matplotlib.collections import PolyCollection
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 from scipy.optimize import isotonic_regression
 
 from hdwf import PARAMETER_COLUMNS, PARAMETER_LABELS, PARAMETERS
@@ -352,6 +353,14 @@ def residual_figure(points: pd.DataFrame, title: str, path) -> None:
     _save(fig, path)
 
 
+def _rung_tick(model: str) -> str:
+    """A ladder rung's tick: the baseline and campaign model by name, a found effect's rung by the
+    effect it adds (``ladder_variants`` labels it 'with a, b, c', cumulative)."""
+    if model.startswith("with "):
+        return "+ " + model[len("with "):].split(", ")[-1]
+    return model
+
+
 def ladder_figure(ladder: pd.DataFrame, noise_arcmin: float | None, title: str, path) -> None:
     """RMSE of each model variant of the ladder, falling rung by rung.
 
@@ -366,15 +375,28 @@ def ladder_figure(ladder: pd.DataFrame, noise_arcmin: float | None, title: str, 
     """
     fig, ax = plt.subplots(figsize=(6.5, 3.6))
     x = np.arange(len(ladder))
-    ax.plot(x, ladder["rmse_arcmin"], "o-", color="tab:blue", label="RMSE (actual solves)")
-    for xi, r in zip(x, ladder["rmse_arcmin"]):
-        ax.annotate(f"{r:.4f}", (xi, r), textcoords="offset points", xytext=(4, 6), fontsize=8)
+    rmse = ladder["rmse_arcmin"].to_numpy(float)
+    ax.plot(x, rmse, "o-", color="tab:blue", label="RMSE (actual solves)")
+    for xi, r in zip(x, rmse):
+        ax.annotate(f"{r:.3g}", (xi, r), textcoords="offset points", xytext=(5, 5), fontsize=8)
     if noise_arcmin:
-        ax.axhline(noise_arcmin, color="tab:gray", ls="--", label=f"noise {noise_arcmin:.4f} arcmin")
-    ax.set_xticks(x, ladder["model"], rotation=15, fontsize=8)
+        ax.axhline(noise_arcmin, color="tab:gray", ls="--", label=f"noise {noise_arcmin:.3g} arcmin")
+    # the rungs are cumulative: each tick names what its rung adds (the full list overlapped)
+    ax.set_xticks(x, [_rung_tick(m) for m in ladder["model"]], fontsize=8)
+    ax.set_xlim(-0.3, len(x) - 0.4)
+    ax.set_xlabel("each rung adds the effect it names to the rung before", fontsize=8)
     ax.set_ylabel("RMSE (arcmin)")
-    top = max(float(ladder["rmse_arcmin"].fillna(0.0).max()), noise_arcmin or 0.0)
-    ax.set_ylim(0, 1.12 * top if top > 0 else None)   # room for the labels
+    shown = np.concatenate([rmse[np.isfinite(rmse) & (rmse > 0)], [noise_arcmin] if noise_arcmin else []])
+    if shown.size and shown.max() > 10 * shown.min():
+        # a fall of 10x or more: on a linear axis the last rungs sit on the floor, indistinguishable
+        ax.set_yscale("log")
+        ax.set_ylim(shown.min() / 1.6, shown.max() * 1.8)
+        ax.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.yaxis.set_minor_formatter(NullFormatter())
+    else:
+        top = float(shown.max()) if shown.size else 0.0
+        ax.set_ylim(0, 1.15 * top if top > 0 else None)   # room for the labels
     ax.legend(fontsize=8)
     ax.set_title(title, fontsize=10)
     _save(fig, path)

@@ -342,7 +342,8 @@ def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2)
     bearing = _bearing_sentence(ladder)
     if bearing:
         doc.text(bearing)
-    doc.figure(campaign.ladder_png, "The error falling rung by rung.", width="75%")
+    doc.figure(campaign.ladder_png, "The error falling rung by rung (each rung adds the effect it names; "
+               "a logarithmic axis when the error falls more than tenfold).", width="75%")
     for name, note in diag.get("notes", {}).items():
         doc.text(f"Note on {lit(name)}: {lit(note)}.")
 
