@@ -157,7 +157,7 @@ def test_agreement_section_labels_the_blind_drive_and_its_misses(named_inputs, t
 
     from hdwf.drive.design import MeshSettings
     from hdwf.report.artefacts import FeSettings
-    from hdwf.report.fe_part import agreement_section
+    from hdwf.report.agreement_part import agreement_section
 
     paper = study_artefacts("paper", STUDY, artefacts_by_owner(*named_inputs))
     table = pd.read_parquet(paper.drive("hd42").lost_motion)
@@ -189,7 +189,7 @@ def test_agreement_section_gives_the_band_under_the_measured_mesh_scatter(named_
 
     from scipy import stats
 
-    from hdwf.report.fe_part import agreement_section
+    from hdwf.report.agreement_part import agreement_section
     from hdwf.study.knee import offset_slopes
 
     paper = study_artefacts("paper", STUDY, artefacts_by_owner(*named_inputs))
@@ -229,7 +229,7 @@ def test_each_missed_or_shaky_target_says_what_share_of_the_draws_meets_it():
     edge (0.8999 shown as 0.900) cannot say whether 0.9 is ever reached."""
     import numpy as np
 
-    from hdwf.report.fe_part import _target_checks
+    from hdwf.report.agreement_part import _target_checks
     from hdwf.study.agreement import Agreement, ScatterBand
 
     a = Agreement(n=27, median_ratio=0.52, spearman=0.886, spearman_p=1e-9, r2=0.83)
@@ -450,3 +450,49 @@ def test_the_ladder_figure_names_each_rungs_effect_and_shows_a_large_fall_on_a_l
     assert low < 0.19 and high > 8.96                                           # every rung and the noise in view
     for fig in drawn:
         plt.close(fig)
+
+
+def test_the_summary_gathers_each_parts_headline_figure(named_inputs, tmp_path):
+    """Ours = the paper's Φ × 1.2 (so median ratio and the least-squares dΦ/dr_FS ratio are both
+    exactly 1.2, Spearman and R² exactly 1), 20 of 27 designs converged, and a campaign whose
+    ladder falls 8.96 → 0.194 arcmin (46.19×): the summary table says each, with its target,
+    the calibrated/blind role and the section that shows it."""
+    import dataclasses
+    import json
+
+    import pandas as pd
+
+    from hdwf.drive.design import MeshSettings
+    from hdwf.report.artefacts import CampaignArtefacts, FeSettings, ReportInputs
+    from hdwf.report.paper_part import largest_sobol_difference
+    from hdwf.report.document import lit
+    from hdwf.report.summary_part import summary_section
+
+    paper = study_artefacts("paper", STUDY, artefacts_by_owner(*named_inputs))
+    table = pd.read_parquet(paper.drive("hd42").lost_motion)
+    table["lost_motion_arcmin"] *= 1.2
+    table.to_parquet(tmp_path / "scaled.parquet")
+    pd.DataFrame({"converged": [True] * 20 + [False] * 7}).to_parquet(tmp_path / "conv.parquet")
+    ours = dataclasses.replace(paper, name="fe_at_paper", source="fe", drives=(dataclasses.replace(
+        paper.drive("hd42"), lost_motion=tmp_path / "scaled.parquet", convergence=tmp_path / "conv.parquet"),))
+    (tmp_path / "diagnosis.json").write_text(json.dumps({"unit": "hd42", "noise_arcmin": 0.19,
+                                                         "verdict": {"found_in_order": ["preload", "fs_cup_torsion"]}}))
+    pd.DataFrame({"rmse_arcmin": [8.96, 0.52, 0.194]}).to_parquet(tmp_path / "ladder.parquet")
+    campaign = CampaignArtefacts("paper_hd42", tmp_path / "diagnosis.json", tmp_path / "ladder.parquet",
+                                 *(tmp_path / "x.png",) * 3)
+    report = ReportInputs((paper, ours), (campaign,), DATA,
+                          FeSettings(MeshSettings(), 5, effects={"preload": {"interference_m": 0.3}}, calibrated_on="hd42"),
+                          (), PROVENANCE)
+    doc = Document("t", "s", PROVENANCE)
+    summary_section(doc, report)
+    rows = next(b for b in doc.blocks if b["type"] == "table")["rows"]
+    by_what = {r[0]: r[1:] for r in rows}
+    sobol = by_what["HD 42: Sobol' indices of the paper's surrogate, largest difference from the published"]
+    assert float(sobol[0]) == pytest.approx(largest_sobol_difference(paper, DATA)["hd42"], abs=1e-4)
+    assert by_what["HD 42: designs of `fe_at_paper` within 2 % on a 1.25× finer mesh"][0] == "20 of 27"
+    assert by_what["HD 42 (calibrated): our $Phi$ over the paper's, median"][:2] == ["1.20", "[0.67, 1.5]"]
+    assert by_what["HD 42 (calibrated): Spearman $rho$, ours against the paper's"][0] == "1.0000"
+    assert by_what["HD 42 (calibrated): $d Phi slash d r_\"FS\"$, ours over the paper's"][0] == "1.20×"
+    ladder = next(r for r in rows if r[0].startswith("`paper_hd42` (HD 42)"))
+    assert ladder[1] == "8.960 → 0.194 arcmin (46.19×)" and ladder[2] == "noise 0.190 arcmin"
+    assert ladder[0].endswith(f"found preload, {lit('fs_cup_torsion')}")

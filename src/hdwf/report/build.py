@@ -12,6 +12,7 @@ from hdwf.report.document import UNIT_NAMES, Document
 from hdwf.report.fe_part import fe_part
 from hdwf.report.paper_part import (comparison_section, correlation_section, designs_section, inputs_section,
                                     paper_part, sobol_section, surrogate_section)
+from hdwf.report.summary_part import summary_section
 from hdwf.report.validation_part import validation_part
 
 _SUBTITLES = {"paper": "The statistics chain on the paper's own FEA tables (its Tables 4 and 5)"}
@@ -85,6 +86,7 @@ def full_report(report: ReportInputs, out) -> Path:
              "diameter of the wave generator's (WG's) bearing; $G_r$, its radial clearance; $r_\"FS\"$ and "
              "$r_\"CS\"$, the normal offsets that thin the FS teeth and widen the CS spaces. A module m is the "
              "gear module (0.18 mm on HD 42, 0.514 mm on HD 120); a preload or layer given in m is in modules.")
+    summary_section(doc, report, 2)
     # Figures drawn here (not by a rule) live until the document is typeset.
     with tempfile.TemporaryDirectory(prefix="hdwf-figs-") as tmp:
         for study in report.paper_studies:

@@ -1,5 +1,5 @@
 """Part II of the report, our FE model: the model and its settings, mesh convergence, torque–twist
-curves, agreement with the paper's FEA at its design points, the Sobol' indices of every study
+curves, agreement with the paper's FEA at its design points (``agreement_part``), the Sobol' indices of every study
 beside the paper's, and the statistics of each FE study. Figures that no rule makes (curves,
 agreement) are drawn into a scratch folder the caller owns."""
 
@@ -15,15 +15,13 @@ from hdwf.common.io import read_json
 from hdwf.fe.cycle import EXIT_ARC_DEG
 from hdwf.fe.hertz import ISO76_BALL_PRESSURE_MPA
 from hdwf.fe.solver import TOL_GAP
+from hdwf.report.agreement_part import AGREEMENT_TARGETS, agreement_section, effects_text
 from hdwf.report.artefacts import FeSettings, ReportInputs, StudyArtefacts
 from hdwf.report.document import UNIT_NAMES, Document, fmt, lit, math_label
-from hdwf.report.figures import agreement_figure, curves_figure
+from hdwf.report.figures import curves_figure
 from hdwf.report.knee_part import knee_section, rank_split_section
 from hdwf.report.paper_part import correlation_section, exact_sobol, sobol_section, surrogate_section
-from hdwf.study.agreement import Agreement, ScatterBand, agreement, agreement_under_mesh_scatter
-from hdwf.study.knee import offset_slope_weights
 from hdwf.study.paper import load_published
-from hdwf.validation.effects import get as get_effect
 
 
 def fe_model_section(doc: Document, assumptions: tuple[dict, ...], pictures: dict[str, Path],
@@ -249,142 +247,6 @@ def curves_section(doc: Document, study: StudyArtefacts, tmp: Path, level: int =
         doc.figure(path, f"{name}: torque–twist curves of the test 0 → +4 % → 0 → −4 % → 0 $T_N$ for three "
                    "designs.", width="70%")
         doc.text(_solve_summary(name, lm))
-
-
-def effects_text(effects) -> str:
-    """``{name: {parameter: value}}`` in words: each effect's title and its parameter values."""
-    return "; ".join(f"{get_effect(name).title.lower()} ("
-                     + ", ".join(f"`{p}` = {v:g}" for p, v in params.items()) + ")"
-                     for name, params in effects.items())
-
-
-#: What "agrees with the paper" means here (issue 15; docs/fe-model.md): level, rank, shape and the
-#: offset slope dΦ/dr_FS, ours over the paper's
-AGREEMENT_TARGETS = {"median_ratio": (0.67, 1.5), "spearman": 0.9, "r2": 0.8, "slope_ratio": (0.5, 2.0)}
-
-
-def _target_checks(name: str, a: Agreement, slope_ratio: float, band: ScatterBand | None = None
-                   ) -> tuple[list[str], list[str]]:
-    """The targets missed, and those met in fewer than 95 % of the mesh-scatter draws (with ``band``);
-    each says in what share of the draws it is met."""
-    lo, hi = AGREEMENT_TARGETS["median_ratio"]
-    s_lo, s_hi = AGREEMENT_TARGETS["slope_ratio"]
-    checks = [("median_ratio", "median ratio", a.median_ratio, (lo, hi), f"{fmt(a.median_ratio, 2)} outside [{lo}, {hi}]"),
-              ("spearman", "Spearman", a.spearman, (AGREEMENT_TARGETS["spearman"], np.inf),
-               f"{fmt(a.spearman)} < {AGREEMENT_TARGETS['spearman']}"),
-              ("r2", "$R^2$", a.r2, (AGREEMENT_TARGETS["r2"], np.inf), f"{fmt(a.r2)} < {AGREEMENT_TARGETS['r2']}"),
-              ("slope_ratio", "$d Phi slash d r_\"FS\"$", slope_ratio, (s_lo, s_hi),
-               f"{fmt(slope_ratio, 2)}× the paper's, outside [{s_lo}, {s_hi:g}]×")]
-    missed, at_risk = [], []
-    for figure, label, value, (low, high), how in checks:
-        share = band.share(figure, low, high) if band is not None and figure in band.samples else None
-        said = "" if share is None else f" (met in {share * 100:.1f} % of the mesh-scatter draws)"
-        if not low <= value <= high:
-            missed.append(f"{name}: {label} {how}{said}")
-        elif share is not None and share < 0.95:
-            at_risk.append(f"{name}: {label}{said}")
-    return missed, at_risk
-
-
-def _scatter_table(doc: Document, rows: list[list[str]]) -> None:
-    doc.text("How far the mesh alone moves these figures: each of our $Phi$ is moved by a relative change drawn "
-             "from the mesh changes measured on the same drive (the designs of the mesh-convergence study, default mesh against "
-             "1.25× finer; Mesh convergence above) with a random sign, 2000 times (seeded). A target met in "
-             "some draws and missed in others could be met or missed by mesh scatter of that size alone; the "
-             "verdict below gives the share of draws that meet each target missed, or met in fewer than 95 %. "
-             "The bands are a lower bound on what the mesh can do: the change at 1.25× understates the default "
-             "mesh's error (docs/fe-model.md, Mesh convergence: against meshes up to 3× finer the default mesh's "
-             "$Phi$ lies 1–12 % high on the eight designs measured), and an error common to all designs moves "
-             "the level, not the rank.")
-    doc.table(["drive", "mesh change", "median ratio", "Spearman $rho$", "$R^2$",
-               "$d Phi slash d r_\"FS\"$ ours/paper"], rows,
-              "The agreement figures under the measured mesh scatter, 5–95 % of the draws (mesh change: median "
-              "and largest measured; `hdwf.study.agreement`).")
-
-
-def _verdict_text(misses: list[str], at_risk: list[str]) -> str:
-    lo, hi = AGREEMENT_TARGETS["median_ratio"]
-    s_lo, s_hi = AGREEMENT_TARGETS["slope_ratio"]
-    return (f"Targets (level, rank, shape, offset slope): median ratio within [{lo}, {hi}], Spearman $rho >= "
-            f"{AGREEMENT_TARGETS['spearman']}$, $R^2 >= {AGREEMENT_TARGETS['r2']}$, least-squares "
-            f"$d Phi slash d r_\"FS\"$ within [{s_lo}, {s_hi:g}]× the paper's. "
-            + ("Missed: " + "; ".join(misses) + "." if misses else "All met.")
-            + (" Met, but not in 95 % of the mesh-scatter draws: " + "; ".join(at_risk) + "." if at_risk else ""))
-
-
-def agreement_section(doc: Document, units: list[str], paper: StudyArtefacts, ours: StudyArtefacts, tmp: Path,
-                      settings: FeSettings | None = None, level: int = 1,
-                      mesh_changes: dict[str, Path] | None = None) -> None:
-    """Our lost motion against the paper's FEA at the same design points: table and figure.
-
-    Parameters
-    ----------
-    doc
-        The document to add to.
-    units
-        The drives both studies have.
-    paper
-        The study on the paper's tables.
-    ours
-        The FE study at the paper's design points.
-    tmp
-        A scratch folder for the figure; it must outlive ``doc.compile``.
-    settings
-        The FE settings: with effects calibrated on one drive, the rows say which is calibrated and
-        which blind.
-    level
-        Heading level of the section.
-    mesh_changes
-        Per drive, a ``convergence.parquet`` of the same model: its measured mesh changes give the
-        band of each figure under mesh scatter (``hdwf.study.agreement``).
-    """
-    doc.heading("Our FE against the paper's FEA at its own design points", level)
-    effects = settings.effects if settings else {}
-    calibrated_on = settings.calibrated_on if settings else None
-    rows, pairs, misses, at_risk, scatter_rows = [], {}, [], [], []
-    for u in units:
-        theirs = pd.read_parquet(paper.drive(u).lost_motion).set_index("design_id")["lost_motion_arcmin"]
-        our_table = pd.read_parquet(ours.drive(u).lost_motion).set_index("design_id")
-        mine = our_table["lost_motion_arcmin"]
-        both = pd.concat({"paper": theirs, "ours": mine}, axis=1).dropna()
-        a = agreement(both["paper"], both["ours"])
-        ratio = both["ours"] / both["paper"]
-        pairs[UNIT_NAMES[u]] = (theirs.reindex(mine.index).to_numpy(float), mine.to_numpy(float))
-        role = "" if not (effects and calibrated_on) else (" (calibrated)" if u == calibrated_on else " (blind)")
-        weights = offset_slope_weights(our_table.loc[both.index])["rFS_mm"]
-        slope_ratio = (weights @ both["ours"].to_numpy()) / (weights @ both["paper"].to_numpy())
-        band = None
-        if mesh_changes and mesh_changes.get(u):
-            changes = pd.read_parquet(mesh_changes[u])["rel_change_fine"]
-            band = agreement_under_mesh_scatter(both["paper"], both["ours"], changes, slope_weights=weights)
-            scatter_rows.append([UNIT_NAMES[u] + role, f"{fmt(changes.abs().median() * 100, 2)} %, {fmt(changes.abs().max() * 100, 1)} %",
-                                 *(f"{fmt(lo, 3)}–{fmt(hi, 3)}" for lo, hi in (band.median_ratio, band.spearman, band.r2)),
-                                 f"{fmt(slope_ratio, 2)}× ({fmt(band.slope_ratio[0], 2)}–{fmt(band.slope_ratio[1], 2)}×)"])
-        missed, risky = _target_checks(UNIT_NAMES[u] + role, a, slope_ratio, band)
-        misses += missed
-        at_risk += risky
-        rows.append([UNIT_NAMES[u] + role, f"{len(both)} of {len(mine)}", fmt(a.spearman), fmt(a.spearman_p, 3), fmt(a.r2),
-                     fmt(both["paper"].mean(), 3), fmt(both["ours"].mean(), 3), fmt(a.median_ratio, 2),
-                     f"{fmt(ratio.min(), 2)}–{fmt(ratio.max(), 2)}"])
-    doc.table(["drive", "designs solved", "Spearman $rho$", "p", "$R^2$", "paper mean $Phi$", "our mean $Phi$",
-               "median ratio ours/paper", "ratio range"], rows,
-              "Agreement of our $Phi$ with the paper's at the 27 design points of its Tables 4/5 ($R^2$ of a linear fit).")
-    if scatter_rows:
-        _scatter_table(doc, scatter_rows)
-    path = tmp / "agreement.png"
-    agreement_figure(pairs, "hdwf FE vs the paper's Ansys FEA, same 27 designs", path)
-    doc.figure(path, "Our lost motion against the paper's at the same design points.",
-               width="100%" if len(pairs) > 1 else "55%")
-    verdict = _verdict_text(misses, at_risk)
-    if effects:
-        doc.text(f"Our model here: the section with {effects_text(effects)}. " + verdict + " The knee below "
-                 "shows where the shape parts: the uniform 2D section either holds the teeth preloaded or has "
-                 "lost them, where the paper's 3D cup loses its engagement gradually.")
-    else:
-        doc.text("The ranking is what the study needs (which parameters matter). " + verdict + " The bare 2D section "
-                 "has rigid-body flank backlash from $r_\"FS\"$, $r_\"CS\"$ with no preload to take it up; the "
-                 "paper's 3D model evidently takes most of it up. The campaigns `paper_hd42` and `paper_hd120` of "
-                 "Part III search for the effect that does, and the knee below shows what is left.")
 
 
 def _indices_rows(pub: pd.DataFrame, unit: str, studies: list[StudyArtefacts]) -> list[list[str]]:

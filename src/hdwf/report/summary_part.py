@@ -1,0 +1,101 @@
+"""The report's opening summary: the headline figure of each part, read from the same artefacts the
+parts read, with the target or reference it is held against and the section that shows it in full.
+It computes nothing the parts do not; it only gathers their conclusions on one page."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import pandas as pd
+
+from hdwf.common.io import read_json
+from hdwf.report.agreement_part import AGREEMENT_TARGETS, drive_role, paper_agreement
+from hdwf.report.artefacts import ReportInputs
+from hdwf.report.document import UNIT_NAMES, Document, fmt, lit
+from hdwf.report.paper_part import largest_sobol_difference
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One row of the summary: what is measured, its value, what it is held against, where shown."""
+
+    what: str
+    value: str
+    against: str
+    where: str
+
+
+def _replication(report: ReportInputs) -> list[Finding]:
+    found = []
+    for study in report.paper_studies:
+        for unit, diff in largest_sobol_difference(study, report.data_dir).items():
+            found.append(Finding(f"{UNIT_NAMES[unit]}: Sobol' indices of the paper's surrogate, largest "
+                                 "difference from the published", fmt(diff, 4), "the published values (the paper's bounds are unstated)",
+                                 "Part I, Our figures against the paper's"))
+    return found
+
+
+def _fe_model(report: ReportInputs) -> list[Finding]:
+    found = []
+    for study in report.fe_studies:
+        for drive in study.drives:
+            if drive.convergence:
+                conv = pd.read_parquet(drive.convergence)
+                found.append(Finding(f"{UNIT_NAMES[drive.unit]}: designs of `{study.name}` within 2 % on a 1.25× "
+                                     "finer mesh", f"{int(conv['converged'].sum())} of {len(conv)}", "all",
+                                     "Part II, Mesh convergence"))
+    at_paper = [s for s in report.fe_studies if s.designs == "paper"]
+    if not (at_paper and report.paper_studies):
+        return found
+    lo, hi = AGREEMENT_TARGETS["median_ratio"]
+    s_lo, s_hi = AGREEMENT_TARGETS["slope_ratio"]
+    paper, ours = report.paper_studies[0], at_paper[0]
+    for unit in (u for u in ours.units if u in paper.units):
+        pa = paper_agreement(paper, ours, unit)
+        name = UNIT_NAMES[unit] + drive_role(report.fe_settings, unit)
+        where = "Part II, Our FE against the paper's FEA"
+        found += [Finding(f"{name}: our $Phi$ over the paper's, median", fmt(pa.figures.median_ratio, 2),
+                          f"[{lo}, {hi}]", where),
+                  Finding(f"{name}: Spearman $rho$, ours against the paper's", fmt(pa.figures.spearman),
+                          f"≥ {AGREEMENT_TARGETS['spearman']}", where),
+                  Finding(f"{name}: $R^2$, ours against the paper's", fmt(pa.figures.r2),
+                          f"≥ {AGREEMENT_TARGETS['r2']}", where),
+                  Finding(f"{name}: $d Phi slash d r_\"FS\"$, ours over the paper's", f"{fmt(pa.slope_ratio, 2)}×",
+                          f"[{s_lo}, {s_hi:g}]×", where)]
+    return found
+
+
+def _campaigns(report: ReportInputs) -> list[Finding]:
+    found = []
+    for campaign in report.campaigns:
+        diag = read_json(campaign.diagnosis)
+        rmse = pd.read_parquet(campaign.ladder)["rmse_arcmin"].to_numpy(float)
+        named = diag.get("verdict", {}).get("found_in_order") or []
+        value = f"{fmt(rmse[0], 3)} → {fmt(rmse[-1], 3)} arcmin ({fmt(rmse[0] / rmse[-1], 2)}×)"
+        noise = diag.get("noise_arcmin")
+        found.append(Finding(f"`{campaign.name}` ({UNIT_NAMES[diag['unit']]}): RMSE, bare model to the last rung; "
+                             f"found {', '.join(lit(n) for n in named) if named else 'nothing'}", value,
+                             f"noise {fmt(noise, 3)} arcmin" if noise else "–",
+                             f"Part III, Campaign '{lit(campaign.name)}'"))
+    return found
+
+
+def summary_section(doc: Document, report: ReportInputs, level: int = 2) -> None:
+    """The headline figures of Parts I–III in one table (what the parts show in full).
+
+    Parameters
+    ----------
+    doc
+        The document to add to.
+    report
+        Every study and campaign the report shows.
+    level
+        Heading level of the section.
+    """
+    findings = _replication(report) + _fe_model(report) + _campaigns(report)
+    if not findings:
+        return
+    doc.heading("At a glance", level)
+    doc.table(["what", "value", "held against", "shown in"],
+              [[f.what, f.value, f.against, f.where] for f in findings],
+              "The headline figure of each part, from the same artefacts as the part that shows it in full.")
