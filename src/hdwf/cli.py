@@ -8,6 +8,7 @@ import json
 import math
 import os
 import sys
+from contextlib import contextmanager
 from pathlib import Path
 
 from hdwf import __version__
@@ -71,6 +72,18 @@ def _refuse_existing(out: Path, args, why: str = "") -> None:
         raise InputError(out, "is a folder: name the output file", field="--out")
     if out.exists() and not args.force:
         raise InputError(out, f"exists; {why}use --force to replace it", field="--out")
+
+
+@contextmanager
+def _new_output(out: Path, args):
+    """``atomic_path`` that replaces only with --force: a file made at ``out`` while a long solve ran
+    (after ``_refuse_existing`` looked) is kept too."""
+    try:
+        with atomic_path(out, replace=args.force) as tmp:
+            yield tmp
+    except FileExistsError:
+        raise InputError(out, "was made by something else while this ran: it is kept and nothing was written; "
+                              "use --force to replace it", field="--out") from None
 
 
 def _solve_setup(args) -> SolveSetup:
@@ -148,7 +161,7 @@ def _synth(args) -> int:
         data = synthesize(_solve_setup(args), args.designs, args.seed, args.noise_arcmin, effects, ranges)
     except ValueError as exc:
         raise InputError("command line", str(exc)) from None
-    with atomic_path(out) as tmp:
+    with _new_output(out, args) as tmp:
         if out.suffix.lower() == ".csv":
             data.to_csv(tmp, index=False, float_format="%.9g")
         else:
@@ -195,7 +208,7 @@ def _plan(args) -> int:
               f"{(f'{100 * sd:.0f} %' if sd < 10 else '>1000 %'):>7}  {'yes' if c.visible else 'no'}")
     print("  (arcmin; noise to show: ΔBIC -10; to calibrate: parameter within 15 % at two sd)")
     if out is not None:
-        with atomic_path(out) as tmp:
+        with _new_output(out, args) as tmp:
             Path(tmp).write_text(json.dumps(json_safe(plan.to_dict()), indent=1))
         print(f"{out}: written")
     return 0
@@ -205,7 +218,7 @@ def _paper_measurements(args) -> int:
     out = Path(args.out)
     _refuse_existing(out, args, "measurement files are never overwritten: ")
     data = paper_measurements(args.data, args.unit)
-    with atomic_path(out) as tmp:
+    with _new_output(out, args) as tmp:
         data.to_csv(tmp, index=False, float_format="%.10g")
     print(f"{out}: {len(data)} specimens of {args.unit} from the paper's Tables 4/5 (lost_motion form)")
     return 0

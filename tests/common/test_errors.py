@@ -10,7 +10,7 @@ from hdwf.config import load_config, validate_config
 from hdwf.common.errors import ConfigError, InputError
 from hdwf.study.paper import load_fea_designs
 
-from conftest import ROOT
+from conftest import DATA, ROOT
 
 SCHEMA = ROOT / "src" / "hdwf" / "config.schema.yaml"
 
@@ -185,3 +185,24 @@ def test_an_output_that_is_a_folder_is_refused_even_with_force(tmp_path, capsys,
     rc = main([*command, "--out", str(folder), "--force"])
     assert rc == 2 and (folder / "keep").read_text() == "keep me"
     assert capsys.readouterr().err.strip() == f"hdwf: error: {folder}, field '--out': is a folder: name the output file"
+
+
+def test_paper_measurements_keeps_a_file_made_at_out_while_it_ran(tmp_path, capsys, monkeypatch):
+    """The --out check comes before the work; a file made there meanwhile (another run, a user)
+    was replaced by the final rename. Now it is kept and the command says so, exit 2."""
+    import hdwf.cli as cli
+
+    out = tmp_path / "m.csv"
+    real = cli.paper_measurements
+
+    def slow(data, unit):
+        out.write_text("made meanwhile")
+        return real(data, unit)
+
+    monkeypatch.setattr(cli, "paper_measurements", slow)
+    rc = main(["paper-measurements", "--unit", "hd42", "--data", str(DATA), "--out", str(out)])
+    assert rc == 2 and out.read_text() == "made meanwhile" and [p.name for p in tmp_path.iterdir()] == ["m.csv"]
+    assert capsys.readouterr().err.strip() == (f"hdwf: error: {out}, field '--out': was made by something else while "
+                                               "this ran: it is kept and nothing was written; use --force to replace it")
+    assert main(["paper-measurements", "--unit", "hd42", "--data", str(DATA), "--out", str(out), "--force"]) == 0
+    assert out.read_text().startswith("specimen_id,")

@@ -27,6 +27,22 @@ def test_failed_write_leaves_previous_file_intact(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["result.json"]  # no temporary left behind
 
 
+def test_a_write_that_may_not_replace_keeps_a_file_made_meanwhile(tmp_path):
+    """`hdwf synth --out m.csv` (no --force) checks m.csv before a solve of minutes; a file made
+    there in that time was replaced by the final rename. Without ``replace`` it is kept, the write
+    fails with FileExistsError and leaves no temporary; a free name is written as before."""
+    target = tmp_path / "m.csv"
+    with pytest.raises(FileExistsError):
+        with atomic_path(target, replace=False) as tmp:
+            tmp.write_text("ours")
+            target.write_text("someone else's")    # made while the block ran
+    assert target.read_text() == "someone else's"
+    assert [p.name for p in tmp_path.iterdir()] == ["m.csv"]
+    with atomic_path(tmp_path / "n.csv", replace=False) as tmp:
+        tmp.write_text("ours")
+    assert (tmp_path / "n.csv").read_text() == "ours" and len(list(tmp_path.iterdir())) == 2
+
+
 def test_config_hash_ignores_key_order():
     assert config_hash({"a": 1, "b": {"c": 2, "d": 3}}) == config_hash({"b": {"d": 3, "c": 2}, "a": 1})
     assert config_hash({"a": 1}) != config_hash({"a": 2})

@@ -7,6 +7,7 @@ would trust.
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import tempfile
@@ -25,8 +26,12 @@ EXTRA_KEY = b"hdwf.meta"
 
 
 @contextmanager
-def atomic_path(path: str | Path):
-    """Yield a temporary path beside ``path``; rename it over ``path`` only if the block succeeds."""
+def atomic_path(path: str | Path, *, replace: bool = True):
+    """Yield a temporary path beside ``path``; move it to ``path`` only if the block succeeds.
+
+    With ``replace=False`` an existing ``path`` is never replaced, even one made while the block ran
+    (a hard link fails where a rename would not): ``FileExistsError``, and the temporary file is gone.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
@@ -37,10 +42,26 @@ def atomic_path(path: str | Path):
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
+        if replace:
+            os.replace(tmp, path)
+        else:
+            _move_unless_exists(Path(tmp), path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def _move_unless_exists(tmp: Path, path: Path) -> None:
+    try:
+        os.link(tmp, path)
+    except FileExistsError:
+        raise
+    except OSError:   # no hard links on this file system: check, then rename (a narrow race remains)
+        if path.exists():
+            raise FileExistsError(errno.EEXIST, "File exists", str(path)) from None
+        os.replace(tmp, path)
+        return
+    tmp.unlink()
 
 
 def unit_of(column: str) -> str | None:
