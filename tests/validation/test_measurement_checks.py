@@ -252,3 +252,23 @@ def test_a_column_named_twice_is_refused_not_read_as_its_first(tmp_path, name):
         pq.write_table(pa.Table.from_arrays([pa.array(df[c]) for c in df.columns],
                                             names=[*df.columns[:-1], "twist_arcmin"]), path)
     assert _refused(path) == [f"{path}, field 'twist_arcmin': the header names this column 2 times: keep one"]
+
+
+@pytest.mark.parametrize("rename, says", [
+    ({"u_twist_arcmin": "u_twist_arcmn"}, "field 'u_twist_arcmn': not a column the loader reads: 'u_twist_arcmin' misspelled?"),
+    ({"u_twist_arcmin": "U_Twist_Arcmin"}, "field 'U_Twist_Arcmin': not a column the loader reads: 'u_twist_arcmin' misspelled?"),
+    ({"u_twist_arcmin": "u_arcmin"}, "field 'u_arcmin': the curve form's uncertainty column is 'u_twist_arcmin'"),
+    ({"torque_Nm": "Torque_Nm"}, "field 'Torque_Nm': not a column the loader reads: 'torque_Nm' misspelled?"),
+])
+def test_a_column_meant_for_the_loader_but_ignored_is_refused(tmp_path, rename, says):
+    """Other columns are ignored, so a mistyped uncertainty column made the campaign fall back to
+    the stated noise without a word. A name one typo or a case away from an absent read column
+    (difflib ratio >= 0.85), or another form's uncertainty column, is refused with the right name."""
+    lines = _refused(write_table(_curve().rename(columns=rename), tmp_path))
+    assert any(says in line for line in lines), lines
+
+
+def test_columns_that_merely_resemble_a_present_one_are_still_ignored(tmp_path):
+    """A raw twist kept beside the read one, and notes, are the user's own columns: kept, ignored."""
+    df = _curve().assign(twist_arcmin_raw=1.0, notes="bench 2")
+    assert len(load_measurements(write_table(df, tmp_path)).specimens) == 2

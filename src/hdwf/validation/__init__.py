@@ -2,7 +2,8 @@
 
 One module per idea, in the order a campaign uses them:
 
-* ``measurements``: the bench's file format, read and checked;
+* ``measurements``: the bench's file format, read and checked (``measurement_header``: its
+  columns, before any value);
 * ``effects``: the candidate physical effects (one module each) and their registry;
 * ``variants``: the model with effects switched on (variant keys, a campaign's variants) and
   their solves per specimen, in a process pool;

@@ -30,14 +30,8 @@ import pyarrow.parquet as pq
 from hdwf import PARAMETER_COLUMNS, PARAMETERS, UNITS
 from hdwf.common.errors import InputError
 from hdwf.drive.geometry import unit_data
+from hdwf.validation.measurement_header import FORMS, UNCERTAINTY_COLUMN, header_problems
 
-ID_COLUMNS = ["specimen_id", "unit", *PARAMETER_COLUMNS]
-FORMS = {
-    "curve": ["step", "torque_Nm", "twist_arcmin"],
-    "phi": ["phi_plus_arcmin", "phi_minus_arcmin"],
-    "lost_motion": ["lost_motion_arcmin"],
-}
-UNCERTAINTY_COLUMN = {"curve": "u_twist_arcmin", "phi": "u_arcmin", "lost_motion": "u_arcmin"}
 # The largest reading the loader believes (arcmin): Φ, φ, φ′, |twist| and a stated uncertainty.
 # A harmonic drive's lost motion is about 0.1-10 arcmin (the paper's Tables 4 and 5: 0.18-2.5;
 # the shipped demo's dead band about 9); 600 arcmin (10°) is far beyond any drive whose teeth
@@ -59,12 +53,6 @@ SIGN_TEST_STANDARD_ERRORS = 3.0
 SPECIMEN_ID_PATTERN = r"[A-Za-z0-9_.\-]+"
 # How much of a file is looked at to tell text from binary before parsing it.
 _SNIFF_BYTES = 65536
-# Columns that carry the right quantity in the wrong unit: named so the user knows what to convert.
-_WRONG_UNITS = {
-    "torque": ("torque_Nm", ["torque_kNm", "torque_Nmm", "torque_mNm", "torque_lbfin", "torque_ozin", "torque"]),
-    "twist": ("twist_arcmin", ["twist_deg", "twist_rad", "twist_arcsec", "twist_mrad", "twist_urad", "twist"]),
-    "lost_motion": ("lost_motion_arcmin", ["lost_motion_deg", "lost_motion_arcsec", "lost_motion_rad"]),
-}
 # Table 3 bounds of each drive (mm). The same numbers as data/paper/table3_bounds.csv, which
 # ``hdwf.study.paper.table3_bounds(data_dir, unit)`` reads: kept here so that checking a
 # measurement file or synthesising one needs no data directory (tests/validation/
@@ -204,13 +192,6 @@ def _not_parquet(path: Path, exc: Exception) -> MeasurementError:
     return _unreadable(path, f"cannot read the measurement file: not a Parquet file ({why})")
 
 
-def _form_of(columns) -> str | None:
-    for form, cols in FORMS.items():
-        if all(c in columns for c in cols):
-            return form
-    return None
-
-
 def load_measurements(path: str | Path, unit: str | None = None) -> Measurements:
     """Read and check a measurement file.
 
@@ -237,7 +218,7 @@ def load_measurements(path: str | Path, unit: str | None = None) -> Measurements
     if unit is not None and unit not in UNITS:
         raise ValueError(f"unknown drive {unit!r}; the model knows {list(UNITS)}")
     raw = _read_raw(path)
-    form, problems = _header_problems(list(raw.columns))
+    form, problems = header_problems(list(raw.columns))
     if problems:
         raise MeasurementError(path, problems)
     if len(raw) == 0:
@@ -251,24 +232,6 @@ def load_measurements(path: str | Path, unit: str | None = None) -> Measurements
         raise MeasurementError(path, sorted(problems, key=lambda p: (p[0] or 0)))
     specimens = _specimen_table(data, form)
     return Measurements(path=path, form=form, data=data, specimens=specimens)
-
-
-def _header_problems(cols: list[str]) -> tuple[str | None, list[tuple]]:
-    """The form the columns give, and what is wrong with them (wrong units, missing columns)."""
-    problems = []
-    for quantity, (right, wrongs) in _WRONG_UNITS.items():
-        for w in wrongs:
-            if w in cols and right not in cols:
-                problems.append((None, w, None, f"wrong unit: give {quantity} as '{right}'"))
-    form = _form_of(cols)
-    if form is None:
-        problems.append((None, "twist_arcmin", None,
-                         "no measured quantity: need step, torque_Nm, twist_arcmin (curve), or phi_plus_arcmin, "
-                         "phi_minus_arcmin, or lost_motion_arcmin; found " + ", ".join(map(str, cols))))
-    for c in ID_COLUMNS:
-        if c not in cols:
-            problems.append((None, c, None, "missing column"))
-    return form, problems
 
 
 def _typed_data(raw: pd.DataFrame, form: str) -> tuple[pd.DataFrame, list[tuple]]:
