@@ -98,3 +98,20 @@ def test_document_blocks():
         {"type": "figure", "path": "fig00.png", "caption": "fig", "width": "50%"},
         {"type": "pagebreak"},
     ]
+
+
+@pytest.mark.skipif(shutil.which("pdftotext") is None, reason="needs pdftotext (poppler-utils)")
+def test_an_unnumbered_heading_and_a_table_of_text_typeset(tmp_path):
+    """The summary before Part I is not section 0.1, and its table of text has the given widths,
+    left-aligned; the numbering of what follows starts at 1 as before."""
+    doc = Document("t", "s", PROVENANCE)
+    doc.heading("At a glance", 1, numbered=False)
+    doc.table(["what", "value"], [["a long description of a figure", "0.99"]], "cap", widths=["3fr", "1fr"])
+    doc.heading("Part I", 1)
+    assert doc.blocks[0] == {"type": "heading", "level": 1, "text": "At a glance", "numbered": False}
+    assert doc.blocks[1]["widths"] == ["3fr", "1fr"]
+    with pytest.raises(ValueError, match="1 widths for 2 columns"):
+        doc.table(["what", "value"], [], "cap", widths=["1fr"])
+    shown = subprocess.run(["pdftotext", str(doc.compile(tmp_path / "t.pdf")), "-"], capture_output=True, text=True,
+                           check=True).stdout
+    assert "1 Part I" in shown and "At a glance" in shown and "0.1" not in shown and "1 At a glance" not in shown

@@ -86,7 +86,7 @@ def full_report(report: ReportInputs, out) -> Path:
              "diameter of the wave generator's (WG's) bearing; $G_r$, its radial clearance; $r_\"FS\"$ and "
              "$r_\"CS\"$, the normal offsets that thin the FS teeth and widen the CS spaces. A module m is the "
              "gear module (0.18 mm on HD 42, 0.514 mm on HD 120); a preload or layer given in m is in modules.")
-    summary_section(doc, report, 2)
+    summary_section(doc, report)
     # Figures drawn here (not by a rule) live until the document is typeset.
     with tempfile.TemporaryDirectory(prefix="hdwf-figs-") as tmp:
         for study in report.paper_studies:

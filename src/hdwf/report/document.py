@@ -110,8 +110,8 @@ class Document:
         self.blocks: list[dict] = []
         self._figures: list[Path] = []
 
-    def heading(self, text: str, level: int = 1) -> None:
-        """Add a numbered heading.
+    def heading(self, text: str, level: int = 1, numbered: bool = True) -> None:
+        """Add a heading, numbered unless ``numbered`` is false.
 
         Parameters
         ----------
@@ -119,8 +119,10 @@ class Document:
             Plain text, shown as it is (not markup: do not escape it).
         level
             1 for a part or chapter, 2 for a section, and so on.
+        numbered
+            False for a heading outside the parts' numbering (a summary before Part I).
         """
-        self.blocks.append({"type": "heading", "level": level, "text": text})
+        self.blocks.append({"type": "heading", "level": level, "text": text, **({} if numbered else {"numbered": False})})
 
     def text(self, markup: str) -> None:
         """Add a paragraph.
@@ -132,7 +134,7 @@ class Document:
         """
         self.blocks.append({"type": "text", "text": markup})
 
-    def table(self, columns: list[str], rows: list[list], caption: str) -> None:
+    def table(self, columns: list[str], rows: list[list], caption: str, widths: list[str] | None = None) -> None:
         """Add a table with a caption.
 
         Parameters
@@ -143,9 +145,18 @@ class Document:
             Cells: markup strings as they are, anything else through ``fmt``.
         caption
             The caption (markup).
+        widths
+            Typst column widths (``"2fr"``, ``"auto"``) for a table of text: its columns are then
+            all left-aligned. By default every column is as wide as its cells and all but the
+            first, which hold numbers, are right-aligned.
         """
-        self.blocks.append({"type": "table", "columns": columns, "caption": caption,
-                            "rows": [[c if isinstance(c, str) else fmt(c) for c in r] for r in rows]})
+        if widths is not None and len(widths) != len(columns):
+            raise ValueError(f"{len(widths)} widths for {len(columns)} columns")
+        block = {"type": "table", "columns": columns, "caption": caption,
+                 "rows": [[c if isinstance(c, str) else fmt(c) for c in r] for r in rows]}
+        if widths is not None:
+            block["widths"] = widths
+        self.blocks.append(block)
 
     def figure(self, path, caption: str, width: str = "100%") -> None:
         """Add an image with a caption; the file is copied when the document is typeset.
