@@ -496,3 +496,25 @@ def test_the_summary_gathers_each_parts_headline_figure(named_inputs, tmp_path):
     ladder = next(r for r in rows if r[0].startswith("`paper_hd42` (HD 42)"))
     assert ladder[1:4] == ["8.960 → 0.194 arcmin (46.19×)", "stated noise 0.190 arcmin", "–"]
     assert ladder[0].endswith(f"found preload, {lit('fs_cup_torsion')}")
+
+
+def test_a_campaign_on_a_coarser_mesh_than_the_studies_says_what_that_costs():
+    """The paper campaigns solve on 5 × 3, the studies on 10 × 6: the chapter says so beside the
+    mesh, with the scatter it brings (docs/validation.md); a campaign on the studies' mesh, or a
+    finer one, says nothing more."""
+    from hdwf.drive.design import MeshSettings
+    from hdwf.report.validation_part import _campaign_intro
+
+    diag = {"measurements": "data/x.csv", "n_specimens": 3, "n_points": 3, "form": "lost_motion",
+            "noise_arcmin": None, "mesh": {"elements_over_height": 5, "elements_over_thickness": 3, "refinement": 1.0},
+            "model": {"fixed": {}}, "ranking": [{"effect": "thermal"}]}
+    doc = Document("t", "s", {})
+    _campaign_intro(doc, diag, MeshSettings())
+    assert "5 × 3 elements per tooth (coarser than the studies' 10 × 6" in doc.blocks[-1]["text"]
+    assert "ladder's rungs carry that scatter" in doc.blocks[-1]["text"]
+    for mesh in ({"elements_over_height": 10, "elements_over_thickness": 6},
+                 {"elements_over_height": 5, "elements_over_thickness": 3, "refinement": 2.0}):
+        _campaign_intro(doc, {**diag, "mesh": mesh}, MeshSettings())
+        assert "coarser" not in doc.blocks[-1]["text"]
+    _campaign_intro(doc, diag, MeshSettings(refinement=0.5))      # the studies at 5 × 3 themselves
+    assert "coarser" not in doc.blocks[-1]["text"]

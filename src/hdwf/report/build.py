@@ -94,5 +94,5 @@ def full_report(report: ReportInputs, out) -> Path:
         if report.fe_studies:
             fe_part(doc, report, Path(tmp))
         if report.campaigns:
-            validation_part(doc, report.campaigns)
+            validation_part(doc, report.campaigns, report.fe_settings.mesh)
         return doc.compile(out)

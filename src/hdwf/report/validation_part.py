@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 
 from hdwf.common.io import read_json
+from hdwf.drive.design import MeshSettings
 from hdwf.fe.hertz import ISO76_BALL_PRESSURE_MPA
 from hdwf.report.artefacts import CampaignArtefacts
 from hdwf.report.document import UNIT_NAMES, Document, fmt, lit
@@ -142,7 +143,22 @@ def refinement_notes(doc: Document, diag: dict) -> None:
             doc.text(f"Caution, {lit(name)}: {lit(r['reason'])}.")
 
 
-def _campaign_intro(doc: Document, diag: dict) -> None:
+def _coarser_mesh(mesh: dict, study_mesh: MeshSettings | None) -> str:
+    """What a campaign mesh coarser than the studies' costs, said where its numbers are read."""
+    if study_mesh is None:
+        return ""
+    campaign_scale, study_scale = mesh.get("refinement", 1.0), study_mesh.refinement
+    if (mesh["elements_over_height"] * campaign_scale >= study_mesh.elements_over_height * study_scale
+            and mesh["elements_over_thickness"] * campaign_scale >= study_mesh.elements_over_thickness * study_scale):
+        return ""
+    study = f"{study_mesh.elements_over_height * study_scale:g} × {study_mesh.elements_over_thickness * study_scale:g}"
+    return (f" (coarser than the studies' {study}, so that every candidate's grid can be "
+            "solved: enough to tell effects apart, but a specimen whose flanks sit at the edge of locking can jump "
+            "between two nearly equal values of an effect, and the ladder's rungs carry that scatter; "
+            "docs/validation.md)")
+
+
+def _campaign_intro(doc: Document, diag: dict, study_mesh: MeshSettings | None = None) -> None:
     """The measurements, the campaign's model and the candidates tried, in one paragraph."""
     noise = diag.get("noise_arcmin")
     about = f"The data: {lit(diag['about'])}. " if diag.get("about") else ""
@@ -150,7 +166,7 @@ def _campaign_intro(doc: Document, diag: dict) -> None:
              f"({lit(diag['form'])} form)"
              + (f", stated noise {fmt(noise, 4)} arcmin" if noise else ", no noise stated")
              + f". Model: our FE model on a mesh of {diag['mesh']['elements_over_height']} × "
-             f"{diag['mesh']['elements_over_thickness']} elements per tooth"
+             f"{diag['mesh']['elements_over_thickness']} elements per tooth" + _coarser_mesh(diag["mesh"], study_mesh)
              + (f", with {lit(', '.join(diag['model']['fixed']))} switched on" if diag["model"]["fixed"] else "") + ". "
              + f"Candidates tried: {lit(', '.join(sorted(r['effect'] for r in diag['ranking'])))}.")
 
@@ -305,7 +321,8 @@ def _bearing_sentence(ladder: pd.DataFrame) -> str:
             f"{ISO76_BALL_PRESSURE_MPA:g} MPa static rating of ISO 76, rung by rung: " + "; ".join(parts) + "." + verdict)
 
 
-def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2) -> None:
+def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2,
+                     study_mesh: MeshSettings | None = None) -> None:
     """One campaign: where the model fails, which effect is missing, what the data could show, the ladder.
 
     Parameters
@@ -316,12 +333,14 @@ def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2)
         The campaign's artefacts.
     level
         Heading level of the chapter; its sections are one level below.
+    study_mesh
+        The FE studies' mesh: a coarser campaign mesh is said to be so, with what that costs.
     """
     diag = read_json(campaign.diagnosis)
     ladder = pd.read_parquet(campaign.ladder)
     noise = diag.get("noise_arcmin")
     doc.heading(f"Campaign '{campaign.name}' ({UNIT_NAMES[diag['unit']]})", level)
-    _campaign_intro(doc, diag)
+    _campaign_intro(doc, diag, study_mesh)
     _where_it_fails(doc, diag, campaign, level + 1)
     signature_section(doc, diag)
     doc.heading("Which effect is missing", level + 1)
@@ -348,7 +367,8 @@ def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2)
         doc.text(f"Note on {lit(name)}: {lit(note)}.")
 
 
-def validation_part(doc: Document, campaigns: tuple[CampaignArtefacts, ...]) -> None:
+def validation_part(doc: Document, campaigns: tuple[CampaignArtefacts, ...],
+                    study_mesh: MeshSettings | None = None) -> None:
     """Part III: a chapter per campaign, in config order.
 
     Parameters
@@ -357,6 +377,8 @@ def validation_part(doc: Document, campaigns: tuple[CampaignArtefacts, ...]) -> 
         The document to add to.
     campaigns
         The campaigns shown.
+    study_mesh
+        The FE studies' mesh (``campaign_chapter``).
     """
     doc.pagebreak()
     doc.heading("Part III — the model against measurements", 1)
@@ -365,4 +387,4 @@ def validation_part(doc: Document, campaigns: tuple[CampaignArtefacts, ...]) -> 
              "when it pays beyond the noise, and re-solves the model with it switched on "
              "(docs/validation.md).")
     for c in campaigns:
-        campaign_chapter(doc, c, 2)
+        campaign_chapter(doc, c, 2, study_mesh)
