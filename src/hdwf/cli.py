@@ -32,11 +32,22 @@ def _print_problems(exc: MeasurementError, prefix: str = "") -> None:
         print(f"hdwf: error: {prefix}{line}", file=sys.stderr)
 
 
+def project_root(config_path: str | Path) -> Path:
+    """Where a config's relative paths start, as Snakemake reads them: the nearest folder at or above
+    the config's that holds a Snakefile (``--configfile configs/x.yaml`` run from the project), else
+    the config's own folder."""
+    folder = Path(config_path).resolve().parent
+    for candidate in (folder, *folder.parents):
+        if (candidate / "Snakefile").is_file():
+            return candidate
+    return folder
+
+
 def _check_config(args) -> int:
     config = load_config(args.config, args.schema)
     print(f"{args.config}: valid; config hash {config_hash(config)}")
     # each campaign's measurement file as the workflow will read it, before any solve
-    root = Path(args.config).resolve().parent
+    root = project_root(args.config)
     failed = False
     for name, camp in config.get("validation", {}).items():
         plan = campaign_plan(name, camp, config["fe"])
@@ -51,8 +62,8 @@ def _check_config(args) -> int:
     missing = [table for table in PAPER_TABLES if not (root / config["paper_data"] / table).is_file()]
     if missing:
         failed = True
-        error = InputError(args.config, f"no {', '.join(missing)} in that folder (relative to the config's "
-                                        "folder; the paper's tables, which the studies and the report read)",
+        error = InputError(args.config, f"no {', '.join(missing)} in {root / config['paper_data']} (the paper's "
+                                        "tables, which the studies and the report read)",
                            field="paper_data", value=config["paper_data"])
         print(f"hdwf: error: {error}", file=sys.stderr)
     else:
@@ -62,7 +73,7 @@ def _check_config(args) -> int:
 
 def _provenance(args) -> int:
     config = load_config(args.config, args.schema)
-    print(json.dumps(provenance(config, Path(args.config).resolve().parent), indent=2))
+    print(json.dumps(provenance(config, project_root(args.config)), indent=2))
     return 0
 
 
@@ -243,7 +254,9 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="hdwf", description="Harmonic-drive lost-motion study tools.")
     parser.add_argument("--version", action="version", version=f"hdwf {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
-    for name, func, help_ in (("check-config", _check_config, "validate a config file against the schema"),
+    for name, func, help_ in (("check-config", _check_config, "validate a config file, the paper's tables and every "
+                               "campaign's measurements (relative paths start at the nearest folder holding a "
+                               "Snakefile, as in the workflow)"),
                               ("provenance", _provenance, "print config hash, git commit and package versions")):
         p = sub.add_parser(name, help=help_)
         p.add_argument("config", nargs="?", default="config.yaml")

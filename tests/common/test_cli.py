@@ -214,3 +214,19 @@ def test_check_config_names_a_paper_data_folder_without_the_papers_tables(tmp_pa
     (tmp_path / "data" / "paper").symlink_to(ROOT / "data" / "paper")
     assert main(["check-config", str(config)]) == 0
     assert "paper_data: data/paper: the paper's 6 tables: ok" in capsys.readouterr().out
+
+
+def test_check_config_reads_a_config_kept_in_a_subfolder_from_the_project_root(tmp_path, capsys):
+    """`snakemake --configfile configs/mine.yaml` reads `data/...` from the project folder; check-config
+    looked beside the config (configs/data/...) and refused a config the workflow runs."""
+    (tmp_path / "Snakefile").write_text("")
+    (tmp_path / "data").mkdir()
+    for name in ("paper", "validation"):
+        (tmp_path / "data" / name).symlink_to(ROOT / "data" / name)
+    (tmp_path / "configs").mkdir()
+    config = tmp_path / "configs" / "mine.yaml"
+    config.write_text((ROOT / "config.yaml").read_text())
+    assert main(["check-config", str(config)]) == 0, capsys.readouterr().err
+    out = capsys.readouterr().out
+    assert "paper_data: data/paper: the paper's 6 tables: ok" in out
+    assert "campaign 'demo': data/validation/demo_hd42.csv: 16 specimens of hd42: ok" in out
