@@ -12,7 +12,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from hdwf import __version__
-from hdwf.common.errors import InputError, SolveFailed
+from hdwf.common.errors import ConfigError, InputError, SolveFailed
 from hdwf.common.io import atomic_path
 from hdwf.common.provenance import config_hash, provenance
 from hdwf.config import SCHEMA_PATH, load_config
@@ -24,6 +24,10 @@ from hdwf.validation.jsonsafe import json_safe
 from hdwf.validation.measurements import MeasurementError, load_measurements, schedule_problems
 from hdwf.validation.synthesis import design_ranges, format_ranges, parse_range, synth_designs, synthesize
 from hdwf.validation.variants import SolveSetup
+
+
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}{'' if n == 1 else 's'}"
 
 
 def _print_problems(exc: MeasurementError, prefix: str = "") -> None:
@@ -44,10 +48,18 @@ def project_root(config_path: str | Path) -> Path:
 
 
 def _check_config(args) -> int:
-    config = load_config(args.config, args.schema)
-    print(f"{args.config}: valid; config hash {config_hash(config)}")
+    # a config problem is the file's, as a measurement file's is (exit 1); 2 is for the command line
+    try:
+        config = load_config(args.config, args.schema)
+    except ConfigError as exc:
+        print(f"hdwf: error: {exc}", file=sys.stderr)
+        if len(args.config) == 1 and exc.field == "(top level)" and "required property" in exc.problem:
+            print(f"hdwf: hint: an overlay (a campaign's file) is checked over its base: hdwf check-config config.yaml "
+                  f"{args.config[0]}", file=sys.stderr)
+        return 1
+    print(f"{' + '.join(args.config)}: valid; config hash {config_hash(config)}")
     # each campaign's measurement file as the workflow will read it, before any solve
-    root = project_root(args.config)
+    root = project_root(args.config[0])
     failed = False
     for name, camp in config.get("validation", {}).items():
         plan = campaign_plan(name, camp, config["fe"])
@@ -57,12 +69,12 @@ def _check_config(args) -> int:
             failed = True
             _print_problems(exc, f"campaign '{name}': ")
             continue
-        print(f"campaign '{name}': {plan.measurements}: {len(specimens)} specimens of {plan.unit}: ok")
+        print(f"campaign '{name}': {plan.measurements}: {_count(len(specimens), 'specimen')} of {plan.unit}: ok")
     # the studies and the report read the paper's tables: a wrong folder fails only at run time
     missing = [table for table in PAPER_TABLES if not (root / config["paper_data"] / table).is_file()]
     if missing:
         failed = True
-        error = InputError(args.config, f"no {', '.join(missing)} in {root / config['paper_data']} (the paper's "
+        error = InputError(args.config[-1], f"no {', '.join(missing)} in {root / config['paper_data']} (the paper's "
                                         "tables, which the studies and the report read)",
                            field="paper_data", value=config["paper_data"])
         print(f"hdwf: error: {error}", file=sys.stderr)
@@ -73,7 +85,7 @@ def _check_config(args) -> int:
 
 def _provenance(args) -> int:
     config = load_config(args.config, args.schema)
-    print(json.dumps(provenance(config, project_root(args.config)), indent=2))
+    print(json.dumps(provenance(config, project_root(args.config[0])), indent=2))
     return 0
 
 
@@ -210,11 +222,12 @@ def _plan(args) -> int:
     batch = format_ranges(ranges)
     print(f"{plan.n_specimens} specimens of {args.unit}{batch} (mean lost motion {plan.mean_lost_motion_arcmin:.3f} "
           f"arcmin), {plan.n_points} points, noise {args.noise_arcmin:g} arcmin per point:")
-    print(f"  {'effect':<16} {'realistic':>12} {'change RMS':>11} {'noise to show':>14} {'to calibrate':>13} "
+    width = max([16, *(len(c.effect) for c in plan.candidates)])
+    print(f"  {'effect':<{width}} {'realistic':>12} {'change RMS':>11} {'noise to show':>14} {'to calibrate':>13} "
           f"{'sd':>7}  visible")
     for c in plan.candidates:
         sd = c.expected_rel_sd
-        print(f"  {c.effect:<16} {c.realistic:>12.4g} {c.change_rms_arcmin:>11.4f} "
+        print(f"  {c.effect:<{width}} {c.realistic:>12.4g} {c.change_rms_arcmin:>11.4f} "
               f"{c.noise_to_show_arcmin:>14.4f} {c.noise_to_calibrate_arcmin:>13.4f} "
               f"{(f'{100 * sd:.0f} %' if sd < 10 else '>1000 %'):>7}  {'yes' if c.visible else 'no'}")
     print("  (arcmin; noise to show: ΔBIC -10; to calibrate: parameter within 15 % at two sd)")
@@ -245,7 +258,7 @@ def _check_measurements(args) -> int:
     except MeasurementError as exc:
         _print_problems(exc)
         return 1
-    print(f"{args.file}: {len(m.specimens)} specimens, {len(m.data)} points, form {m.form}: ok")
+    print(f"{args.file}: {_count(len(m.specimens), 'specimen')}, {_count(len(m.data), 'point')}, form {m.form}: ok")
     return 0
 
 
@@ -259,7 +272,9 @@ def main(argv=None) -> int:
                                "Snakefile, as in the workflow)"),
                               ("provenance", _provenance, "print config hash, git commit and package versions")):
         p = sub.add_parser(name, help=help_)
-        p.add_argument("config", nargs="?", default="config.yaml")
+        p.add_argument("config", nargs="*", default=["config.yaml"],
+                       help="config files, merged in order as Snakemake merges --configfile overlays "
+                            "(e.g. config.yaml workflow/campaigns/paper_coning.yaml); default config.yaml")
         p.add_argument("--schema", default=str(SCHEMA_PATH))
         p.set_defaults(func=func)
     p = sub.add_parser("paper-measurements", help="the paper's Tables 4/5 as a measurement file")
@@ -273,7 +288,9 @@ def main(argv=None) -> int:
                                    "loader and of a campaign for --unit, solving nothing; prints one line per "
                                    "problem and exits 1, or a summary and exits 0.")
     p.add_argument("file", help="a .csv or .parquet measurement file")
-    p.add_argument("--unit", required=True, choices=["hd42", "hd120"], help="the drive the file is for")
+    p.add_argument("--unit", choices=["hd42", "hd120"],
+                   help="the drive the file is for: adds a campaign's checks (every specimen of it, ids that "
+                        "can name files); without it the file's own drives are taken")
     p.add_argument("--steps-per-ramp", type=_bounded(int, 1, 50), default=5,
                    help="the campaign's load steps per ramp: a curve point beyond its test torque by more than "
                         "a quarter of a step is refused (default 5, the config's)")

@@ -117,8 +117,9 @@ def _check_schema(config: dict, schema_path: str | Path, source) -> None:
     errors = sorted(extended(schema).iter_errors(config), key=lambda e: (len(e.absolute_path), str(e.absolute_path)))
     if errors:
         first = errors[0]
+        shown = errors[1:11]
         others = "" if len(errors) == 1 else f" (and {len(errors) - 1} more problem(s): " + "; ".join(
-            f"{_key_path(e)}: {e.message}" for e in errors[1:4]) + ")"
+            f"{_key_path(e)}: {e.message}" for e in shown) + ("; …" if len(errors) - 1 > len(shown) else "") + ")"
         value = first.instance if not isinstance(first.instance, (dict, list)) else None
         raise ConfigError(source, f"{first.message}{others}", field=_key_path(first), value=value)
 
@@ -201,14 +202,35 @@ def _check_effects(where: str, effects: dict, source) -> None:
                               field=f"{where}.effects.{eff}")
 
 
-def load_config(path: str | Path, schema_path: str | Path = SCHEMA_PATH) -> dict:
-    """Read a config file and validate it; a missing, unreadable or malformed file is a ConfigError."""
-    path = Path(path)
+def _read_yaml(path: Path) -> dict:
     try:
-        config = yaml.safe_load(path.read_text()) or {}
+        return yaml.safe_load(path.read_text()) or {}
     except (OSError, UnicodeDecodeError) as exc:
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else "not a text file"
         raise ConfigError(path, f"cannot read the config: {reason}") from exc
     except yaml.YAMLError as exc:
         raise ConfigError(path, f"not valid YAML: {exc}") from exc
-    return validate_config(config, schema_path, path)
+
+
+def _merge(base: dict, override: dict) -> dict:
+    """``override`` merged into ``base`` key by key, nested mappings recursively (as Snakemake merges
+    ``--configfile`` files over the Snakefile's ``configfile:``)."""
+    for key, value in override.items():
+        if isinstance(value, dict) and isinstance(base.get(key), dict):
+            _merge(base[key], value)
+        else:
+            base[key] = value
+    return base
+
+
+def load_config(path: str | Path | list[str | Path], schema_path: str | Path = SCHEMA_PATH) -> dict:
+    """Read a config file, or several merged in order (a base config, then overlays such as a
+    campaign's), and validate the result; a missing, unreadable or malformed file is a ConfigError,
+    and a problem is blamed on the file that sets the key."""
+    paths = [Path(p) for p in ([path] if isinstance(path, (str, Path)) else path)]
+    if not paths:
+        raise ValueError("no config file given")
+    config: dict = {}
+    for p in paths:
+        _merge(config, _read_yaml(p))
+    return validate_config(config, schema_path, paths[0] if len(paths) == 1 else paths)

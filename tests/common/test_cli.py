@@ -32,9 +32,10 @@ def test_check_config_works_outside_the_project(tmp_path):
     (lambda d: d, "Is a directory"),
     (lambda d: (d / "binary.yaml").write_bytes(b"\xff\xfe\x00\x81") and d / "binary.yaml", "not a text file"),
 ])
-def test_an_unreadable_config_is_one_line_and_exit_2(tmp_path, capsys, make, says):
+def test_an_unreadable_config_is_one_line_and_exit_1(tmp_path, capsys, make, says):
+    """The file is wrong, not the command: exit 1, as check-measurements gives for a bad file."""
     path = make(tmp_path)
-    assert main(["check-config", str(path)]) == 2
+    assert main(["check-config", str(path)]) == 1
     assert capsys.readouterr().err.strip().splitlines() == [f"hdwf: error: {path}: cannot read the config: {says}"]
 
 
@@ -230,3 +231,33 @@ def test_check_config_reads_a_config_kept_in_a_subfolder_from_the_project_root(t
     out = capsys.readouterr().out
     assert "paper_data: data/paper: the paper's 6 tables: ok" in out
     assert "campaign 'demo': data/validation/demo_hd42.csv: 16 specimens of hd42: ok" in out
+
+
+def test_check_config_merges_an_overlay_over_its_base_as_snakemake_does(capsys):
+    """A campaign kept in its own file (workflow/campaigns/paper_coning.yaml, run with --configfile)
+    is an overlay: alone it lacks the base's keys, and the command says how to check it; given
+    after its base, it is merged key by key and its campaigns are checked with the base's."""
+    overlay = str(ROOT / "workflow/campaigns/paper_coning.yaml")
+    assert main(["check-config", overlay]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert "'paper_data' is a required property (and 4 more problem(s)" in err[0] and "'fe' is a required" in err[0]
+    assert err[1] == f"hdwf: hint: an overlay (a campaign's file) is checked over its base: hdwf check-config config.yaml {overlay}"
+    assert main(["check-config", str(ROOT / "config.yaml"), overlay]) == 0
+    out = capsys.readouterr().out
+    assert "campaign 'paper_hd42_coning': data/validation/paper_hd42.csv: 27 specimens of hd42: ok" in out
+    assert "campaign 'demo': data/validation/demo_hd42.csv: 16 specimens of hd42: ok" in out   # the base's too
+
+
+def test_check_measurements_without_a_drive_checks_the_file_alone(tmp_path, capsys):
+    """docs/measurements.md: --unit adds a campaign's checks; without it the file's own drives are
+    taken (the demo is of HD 42, so --unit hd120 refuses it and no --unit accepts it), and a count
+    of one reads in the singular."""
+    assert main(["check-measurements", str(DEMO)]) == 0
+    assert capsys.readouterr().out.strip() == f"{DEMO}: 16 specimens, 336 points, form curve: ok"
+    assert main(["check-measurements", str(DEMO), "--unit", "hd120"]) == 1
+    one = tmp_path / "one.csv"
+    pd.read_csv(DEMO).head(1).drop(columns=["step", "torque_Nm", "twist_arcmin", "u_twist_arcmin"]).assign(
+        lost_motion_arcmin=1.0).to_csv(one, index=False)
+    capsys.readouterr()
+    assert main(["check-measurements", str(one)]) == 0
+    assert capsys.readouterr().out.strip() == f"{one}: 1 specimen, 1 point, form lost_motion: ok"

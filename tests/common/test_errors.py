@@ -206,3 +206,17 @@ def test_paper_measurements_keeps_a_file_made_at_out_while_it_ran(tmp_path, caps
                                                "this ran: it is kept and nothing was written; use --force to replace it")
     assert main(["paper-measurements", "--unit", "hd42", "--data", str(DATA), "--out", str(out), "--force"]) == 0
     assert out.read_text().startswith("specimen_id,")
+
+
+def test_a_config_and_its_overlay_merge_key_by_key_and_a_bad_key_is_blamed_on_its_file(tmp_path):
+    """``load_config([base, overlay])`` merges as Snakemake merges --configfile (nested keys kept
+    from the base unless the overlay sets them), and a bad value names the overlay that sets it."""
+    overlay = tmp_path / "overlay.yaml"
+    overlay.write_text("fe:\n  steps_per_ramp: 3\n")
+    base = load_config(ROOT / "config.yaml", SCHEMA)
+    merged = load_config([ROOT / "config.yaml", overlay], SCHEMA)
+    assert merged["fe"]["steps_per_ramp"] == 3 and merged["fe"]["effects"] == base["fe"]["effects"]
+    overlay.write_text("fe:\n  steps_per_ramp: 0\n")
+    with pytest.raises(ConfigError) as exc:
+        load_config([ROOT / "config.yaml", overlay], SCHEMA)
+    assert str(exc.value).startswith(f"{overlay}, field 'fe.steps_per_ramp', value 0:")

@@ -272,3 +272,11 @@ def test_columns_that_merely_resemble_a_present_one_are_still_ignored(tmp_path):
     """A raw twist kept beside the read one, and notes, are the user's own columns: kept, ignored."""
     df = _curve().assign(twist_arcmin_raw=1.0, notes="bench 2")
     assert len(load_measurements(write_table(df, tmp_path)).specimens) == 2
+
+
+def test_a_file_with_no_measured_quantity_names_no_single_column(tmp_path):
+    """A curve file without its torque has no form: the problem is the file's, not that of the
+    twist column (which is there), and it lists what was found."""
+    lines = _refused(write_table(_curve().drop(columns=["torque_Nm"]), tmp_path))
+    assert len(lines) == 1 and lines[0].startswith(f"{tmp_path / 'm.csv'}: no measured quantity: need step, torque_Nm")
+    assert "found specimen_id, unit" in lines[0]

@@ -46,7 +46,7 @@ def header_problems(cols: list[str]) -> tuple[str | None, list[tuple]]:
                 problems.append((None, w, None, f"wrong unit: give {quantity} as '{right}'"))
     form = form_of(cols)
     if form is None:
-        problems.append((None, "twist_arcmin", None,
+        problems.append((None, None, None,           # no one column is at fault: name none
                          "no measured quantity: need step, torque_Nm, twist_arcmin (curve), or phi_plus_arcmin, "
                          "phi_minus_arcmin, or lost_motion_arcmin; found " + ", ".join(map(str, cols))))
     for c in ID_COLUMNS:
