@@ -157,12 +157,17 @@ def _design_ranges(args) -> dict[str, tuple[float, float]]:
     return ranges
 
 
-def _solve_options(p, elements_over_height: int, elements_over_thickness: int) -> None:
-    p.add_argument("--elements-over-height", type=_bounded(int, 2, 40), default=elements_over_height)
-    p.add_argument("--elements-over-thickness", type=_bounded(int, 2, 30), default=elements_over_thickness)
-    p.add_argument("--refinement", type=_bounded(float, 0, 4, low_open=True), default=1.0)
-    p.add_argument("--steps-per-ramp", type=_bounded(int, 1, 50), default=5)
-    p.add_argument("--jobs", type=_bounded(int, 1, 256), default=1, help="processes (one specimen each)")
+def _solve_options(p, elements_over_height: int, elements_over_thickness: int, mesh_is: str) -> None:
+    p.add_argument("--elements-over-height", type=_bounded(int, 2, 40), default=elements_over_height,
+                   help=f"elements over a tooth's height (default %(default)s: {mesh_is})")
+    p.add_argument("--elements-over-thickness", type=_bounded(int, 2, 30), default=elements_over_thickness,
+                   help=f"elements over a tooth's thickness (default %(default)s: {mesh_is})")
+    p.add_argument("--refinement", type=_bounded(float, 0, 4, low_open=True), default=1.0,
+                   help="multiplies both element counts (default %(default)s)")
+    p.add_argument("--steps-per-ramp", type=_bounded(int, 1, 50), default=5,
+                   help="load steps on each ramp of 0 -> +T -> 0 -> -T -> 0 (default %(default)s)")
+    p.add_argument("--jobs", type=_bounded(int, 1, 256), default=1,
+                   help="processes, one specimen each (default %(default)s)")
 
 
 def _synth(args) -> int:
@@ -271,7 +276,7 @@ def main(argv=None) -> int:
                                "campaign's measurements (relative paths start at the nearest folder holding a "
                                "Snakefile, as in the workflow)"),
                               ("provenance", _provenance, "print config hash, git commit and package versions")):
-        p = sub.add_parser(name, help=help_)
+        p = sub.add_parser(name, help=help_, description=help_[0].upper() + help_[1:] + ".")
         p.add_argument("config", nargs="*", default=["config.yaml"],
                        help="config files, merged in order as Snakemake merges --configfile overlays "
                             "(e.g. config.yaml workflow/campaigns/paper_coning.yaml); default config.yaml")
@@ -306,7 +311,7 @@ def main(argv=None) -> int:
                    help="switch an effect on, e.g. tooth_friction:mu=0.08 (repeatable)")
     p.add_argument("--out", required=True, help="output file, .csv or .parquet (never overwritten)")
     p.add_argument("--force", action="store_true", help="replace an existing output file")
-    _solve_options(p, 10, 6)                 # the study's default mesh
+    _solve_options(p, 10, 6, "the FE studies' mesh; give a campaign on such data the mesh they were made with")
     p.set_defaults(func=_synth)
     p = sub.add_parser("plan", help="before measuring: which effects could a test show at a given noise",
                        description="Solves the model and every candidate's grid at N Latin-hypercube "
@@ -316,7 +321,7 @@ def main(argv=None) -> int:
     _specimen_options(p, "seed of the designs", "standard deviation of one reading")
     p.add_argument("--out", help="also write the table as JSON here (never overwritten)")
     p.add_argument("--force", action="store_true", help="replace an existing output file")
-    _solve_options(p, 5, 3)                  # the campaigns' coarse mesh
+    _solve_options(p, 5, 3, "the shipped campaigns' coarse mesh")
     p.set_defaults(func=_plan)
     args = parser.parse_args(argv)
     try:
