@@ -15,7 +15,7 @@ from hdwf import __version__
 from hdwf.common.errors import ConfigError, InputError, SolveFailed
 from hdwf.common.io import atomic_path
 from hdwf.common.provenance import config_hash, provenance
-from hdwf.config import SCHEMA_PATH, load_config
+from hdwf.config import SCHEMA_PATH, blame, load_config
 from hdwf.stages.validation import campaign_plan, campaign_specimens
 from hdwf.study.paper import PAPER_TABLES, paper_measurements
 from hdwf.validation.detectability import plan_detectability
@@ -74,7 +74,7 @@ def _check_config(args) -> int:
     missing = [table for table in PAPER_TABLES if not (root / config["paper_data"] / table).is_file()]
     if missing:
         failed = True
-        error = InputError(args.config[-1], f"no {', '.join(missing)} in {root / config['paper_data']} (the paper's "
+        error = InputError(blame(args.config, "paper_data"), f"no {', '.join(missing)} in {root / config['paper_data']} (the paper's "
                                         "tables, which the studies and the report read)",
                            field="paper_data", value=config["paper_data"])
         print(f"hdwf: error: {error}", file=sys.stderr)
