@@ -204,12 +204,15 @@ def _check_effects(where: str, effects: dict, source) -> None:
 
 def _read_yaml(path: Path) -> dict:
     try:
-        return yaml.safe_load(path.read_text()) or {}
+        loaded = yaml.safe_load(path.read_text()) or {}
     except (OSError, UnicodeDecodeError) as exc:
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else "not a text file"
         raise ConfigError(path, f"cannot read the config: {reason}") from exc
     except yaml.YAMLError as exc:
         raise ConfigError(path, f"not valid YAML: {exc}") from exc
+    if not isinstance(loaded, dict):
+        raise ConfigError(path, f"the top level must be keys and values (a mapping), not a {type(loaded).__name__}")
+    return loaded
 
 
 def _merge(base: dict, override: dict) -> dict:

@@ -261,3 +261,12 @@ def test_check_measurements_without_a_drive_checks_the_file_alone(tmp_path, caps
     capsys.readouterr()
     assert main(["check-measurements", str(one)]) == 0
     assert capsys.readouterr().out.strip() == f"{one}: 1 specimen, 1 point, form lost_motion: ok"
+
+
+def test_a_config_that_is_not_a_mapping_is_named_as_such(tmp_path, capsys):
+    """A YAML list at the top level cannot be merged with another config: one line, exit 1."""
+    path = tmp_path / "list.yaml"
+    path.write_text("- a\n- b\n")
+    assert main(["check-config", str(ROOT / "config.yaml"), str(path)]) == 1
+    assert capsys.readouterr().err.strip() == (f"hdwf: error: {path}: the top level must be keys and values "
+                                               "(a mapping), not a list")
