@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Iterator
 from pathlib import Path
 
 import jsonschema
@@ -125,80 +126,94 @@ def _check_schema(config: dict, schema_path: str | Path, source) -> None:
 
 
 def _check_relations(config: dict, source) -> None:
-    """Rules a JSON schema cannot express."""
+    """Rules a JSON schema cannot express: every problem found, the first with the others listed."""
+    problems = list(_relation_problems(config, source))
+    if len(problems) > 1:
+        first = problems[0]
+        others = "; ".join(f"{p.field}: {p.problem}" for p in problems[1:11]) + ("; …" if len(problems) > 11 else "")
+        raise ConfigError(source, f"{first.problem} (and {len(problems) - 1} more problem(s): {others})",
+                          field=first.field, value=first.value)
+    if problems:
+        raise problems[0]
+
+
+def _relation_problems(config: dict, source) -> Iterator[ConfigError]:
     fe = config.get("fe")
     if fe is not None:
         refs = fe["convergence"]["refinements"]
         if fe["refinement"] not in refs:
-            raise ConfigError(source, f"must contain fe.refinement ({fe['refinement']}), the default mesh, as one of "
+            yield ConfigError(source, f"must contain fe.refinement ({fe['refinement']}), the default mesh, as one of "
                               "the three meshes", field="fe.convergence.refinements", value=refs)
-        if fe["refinement"] == min(refs):
+        elif fe["refinement"] == min(refs):
             # The check compares the two finest meshes, so the study's own mesh must be one of them.
-            raise ConfigError(source, "the default mesh must be one of the two finest of the three",
+            yield ConfigError(source, "the default mesh must be one of the two finest of the three",
                               field="fe.refinement", value=fe["refinement"])
-        _check_effects("fe", fe.get("effects", {}), source)
+        yield from _effect_problems("fe", fe.get("effects", {}), source)
+        fe_study_ok = {}
         for key in ("convergence", "picture"):
             study = fe.get(key, {}).get("study")
-            if study is not None and (study not in config["studies"] or config["studies"][study]["source"] != "fe"):
-                raise ConfigError(source, "must name an fe study", field=f"fe.{key}.study", value=study)
+            fe_study_ok[key] = study in config["studies"] and config["studies"][study]["source"] == "fe"
+            if study is not None and not fe_study_ok[key]:
+                yield ConfigError(source, "must name an fe study", field=f"fe.{key}.study", value=study)
         picture = fe.get("picture", {})
-        if "design" in picture and "study" in picture:
+        if "design" in picture and "study" in picture and fe_study_ok["picture"]:
             units = config["studies"][picture["study"]]["units"]
             missing = [u for u in units if picture["design"] not in design_ids(config, picture["study"], u)]
             if missing:
-                raise ConfigError(source, f"no such design of study '{picture['study']}' for {', '.join(missing)} "
+                yield ConfigError(source, f"no such design of study '{picture['study']}' for {', '.join(missing)} "
                                   f"(e.g. {design_ids(config, picture['study'], missing[0])[0]})",
                                   field="fe.picture.design", value=picture["design"])
     for name, study in config.get("studies", {}).items():
         if study["source"] == "paper" and study.get("designs", "paper") != "paper":
-            raise ConfigError(source, "a paper study uses the paper's designs", field=f"studies.{name}.designs",
+            yield ConfigError(source, "a paper study uses the paper's designs", field=f"studies.{name}.designs",
                               value=study["designs"])
     for name, camp in config.get("validation", {}).items():
-        _check_campaign(name, camp, source)
+        yield from _campaign_problems(name, camp, source)
     sob = config.get("sobol", {})
     n_start = sob.get("n_start")
     if n_start is not None and n_start & (n_start - 1):
-        raise ConfigError(source, "must be a power of two (Sobol' sequences need it)", field="sobol.n_start",
+        yield ConfigError(source, "must be a power of two (Sobol' sequences need it)", field="sobol.n_start",
                           value=n_start)
     if n_start is not None and not n_start <= sob["n_min"] <= sob["n_max"]:
-        raise ConfigError(source, f"need n_start <= n_min <= n_max, got {n_start}, {sob['n_min']}, {sob['n_max']}",
+        yield ConfigError(source, f"need n_start <= n_min <= n_max, got {n_start}, {sob['n_min']}, {sob['n_max']}",
                           field="sobol.n_min", value=sob["n_min"])
 
 
-def _check_campaign(name: str, camp: dict, source) -> None:
+def _campaign_problems(name: str, camp: dict, source) -> Iterator[ConfigError]:
     """Effect names, parameters and values of a campaign against the effects registry."""
     known = registry()
     where = f"validation.{name}"
-    _check_effects(where, camp.get("effects", {}), source)
+    yield from _effect_problems(where, camp.get("effects", {}), source)
     cands = camp.get("candidates", "all")
     if cands != "all":
         for c in cands:
             if c not in known:
-                raise ConfigError(source, f"unknown effect; known: {', '.join(known)}", field=f"{where}.candidates",
+                yield ConfigError(source, f"unknown effect; known: {', '.join(known)}", field=f"{where}.candidates",
                                   value=c)
 
 
-def _check_effects(where: str, effects: dict, source) -> None:
+def _effect_problems(where: str, effects: dict, source) -> Iterator[ConfigError]:
     """Switched-on effects ``{name: {parameter: value | calibrate}}`` under ``where`` against the registry."""
     known = registry()
     for eff, params in effects.items():
         if eff not in known:
-            raise ConfigError(source, f"unknown effect; known: {', '.join(known)}", field=f"{where}.effects",
+            yield ConfigError(source, f"unknown effect; known: {', '.join(known)}", field=f"{where}.effects",
                               value=eff)
+            continue
         names = {p.name for p in known[eff].parameters}
         for pname, value in params.items():
             key = f"{where}.effects.{eff}.{pname}"
             if pname not in names:
-                raise ConfigError(source, f"unknown parameter of {eff}; it has {', '.join(sorted(names))}",
+                yield ConfigError(source, f"unknown parameter of {eff}; it has {', '.join(sorted(names))}",
                                   field=key, value=pname)
-            if value != "calibrate":
+            elif value != "calibrate":
                 try:
                     known[eff].param(pname).check(value, key)
                 except ValueError as exc:
-                    raise ConfigError(source, str(exc).split(": ", 1)[-1], field=key, value=value) from None
+                    yield ConfigError(source, str(exc).split(": ", 1)[-1], field=key, value=value)
         missing = names - set(params)
         if missing:
-            raise ConfigError(source, f"give every parameter of {eff} (missing {', '.join(sorted(missing))})",
+            yield ConfigError(source, f"give every parameter of {eff} (missing {', '.join(sorted(missing))})",
                               field=f"{where}.effects.{eff}")
 
 

@@ -220,3 +220,19 @@ def test_a_config_and_its_overlay_merge_key_by_key_and_a_bad_key_is_blamed_on_it
     with pytest.raises(ConfigError) as exc:
         load_config([ROOT / "config.yaml", overlay], SCHEMA)
     assert str(exc.value).startswith(f"{overlay}, field 'fe.steps_per_ramp', value 0:")
+
+
+def test_every_relation_problem_is_listed_not_only_the_first(tmp_path):
+    """The rules the schema cannot express stopped at the first problem: a user fixed one, ran
+    again and met the next. All are now listed after the first (which names field and value), and
+    a wrong picture study does not also raise a KeyError for its design."""
+    def edit(c):
+        c["sobol"].update(n_start=100)                                        # not a power of two
+        c["fe"].update(effects={"preloud": {"interference_m": 0.1}})          # no such effect
+        c["fe"]["picture"].update(study="paper")                              # not an fe study
+    with pytest.raises(ConfigError) as exc:
+        load_config(_config_with(tmp_path, edit), SCHEMA)
+    msg = str(exc.value)
+    assert "field 'fe.effects', value 'preloud': unknown effect" in msg and "(and 2 more problem(s): " in msg
+    assert "fe.picture.study: must name an fe study" in msg
+    assert "sobol.n_start: must be a power of two" in msg
