@@ -118,23 +118,26 @@ def _check_schema(config: dict, schema_path: str | Path, source) -> None:
     errors = sorted(extended(schema).iter_errors(config), key=lambda e: (len(e.absolute_path), str(e.absolute_path)))
     if errors:
         first = errors[0]
-        shown = errors[1:11]
-        others = "" if len(errors) == 1 else f" (and {len(errors) - 1} more problem(s): " + "; ".join(
-            f"{_key_path(e)}: {e.message}" for e in shown) + ("; …" if len(errors) - 1 > len(shown) else "") + ")"
+        others = _and_the_others([f"{_key_path(e)}: {e.message}" for e in errors[1:]])
         value = first.instance if not isinstance(first.instance, (dict, list)) else None
         raise ConfigError(source, f"{first.message}{others}", field=_key_path(first), value=value)
+
+
+def _and_the_others(problems: list[str], shown: int = 10) -> str:
+    """' (and N more problem(s): a; b; …)' after the first problem of a config, or '' if none."""
+    if not problems:
+        return ""
+    more = "; …" if len(problems) > shown else ""
+    return f" (and {len(problems)} more problem(s): " + "; ".join(problems[:shown]) + more + ")"
 
 
 def _check_relations(config: dict, source) -> None:
     """Rules a JSON schema cannot express: every problem found, the first with the others listed."""
     problems = list(_relation_problems(config, source))
-    if len(problems) > 1:
-        first = problems[0]
-        others = "; ".join(f"{p.field}: {p.problem}" for p in problems[1:11]) + ("; …" if len(problems) > 11 else "")
-        raise ConfigError(source, f"{first.problem} (and {len(problems) - 1} more problem(s): {others})",
-                          field=first.field, value=first.value)
     if problems:
-        raise problems[0]
+        first = problems[0]
+        others = _and_the_others([f"{p.field}: {p.problem}" for p in problems[1:]])
+        raise ConfigError(source, f"{first.problem}{others}", field=first.field, value=first.value)
 
 
 def _relation_problems(config: dict, source) -> Iterator[ConfigError]:
@@ -251,4 +254,4 @@ def load_config(path: str | Path | list[str | Path], schema_path: str | Path = S
     config: dict = {}
     for p in paths:
         _merge(config, _read_yaml(p))
-    return validate_config(config, schema_path, paths[0] if len(paths) == 1 else paths)
+    return validate_config(config, schema_path, paths)

@@ -282,14 +282,24 @@ def _ours(drive: DriveArtefacts, statistic: str, parameter) -> tuple[str, float,
     return f"Sobol' {'$S_i$' if idx == 'S1' else '$S_(T i)$'} (exact)", ours, other
 
 
-def largest_sobol_difference(study: StudyArtefacts, data_dir) -> dict[str, float]:
-    """Per drive of ``study``, the largest |ours − published| over the Sobol' indices the paper publishes."""
+def _published_against_ours(study: StudyArtefacts, data_dir, statistic_prefix: str = "") -> list[tuple]:
+    """Each statistic the paper publishes for the study's drives (starting ``statistic_prefix``):
+    ``(published row, what it is, ours, ours over Table 3's bounds)``."""
+    return [(r, *_ours(study.drive(r.unit), r.statistic, r.parameter)) for r in load_published(data_dir).itertuples()
+            if r.unit in study.units and r.statistic.startswith(statistic_prefix)]
+
+
+def _largest_sobol_difference(compared: list[tuple]) -> dict[str, float]:
     worst: dict[str, float] = {}
-    for r in load_published(data_dir).itertuples():
-        if r.unit in study.units and r.statistic.startswith("sobol_"):
-            _, ours, _ = _ours(study.drive(r.unit), r.statistic, r.parameter)
+    for r, _, ours, _ in compared:
+        if r.statistic.startswith("sobol_"):
             worst[r.unit] = max(worst.get(r.unit, 0.0), abs(ours - r.value))
     return worst
+
+
+def largest_sobol_difference(study: StudyArtefacts, data_dir) -> dict[str, float]:
+    """Per drive of ``study``, the largest |ours − published| over the Sobol' indices the paper publishes."""
+    return _largest_sobol_difference(_published_against_ours(study, data_dir, "sobol_"))
 
 
 def comparison_section(doc: Document, study: StudyArtefacts, data_dir, level: int = 1) -> None:
@@ -306,7 +316,6 @@ def comparison_section(doc: Document, study: StudyArtefacts, data_dir, level: in
     level
         Heading level of the section.
     """
-    pub = load_published(data_dir)
     doc.heading("Our figures against the paper's", level)
     doc.text("Every statistic the paper publishes, recomputed here from its own Tables 4 and 5 (the paper's numbering). Differences are "
              "ours minus the paper's. Sobol' indices depend on the input bounds, which the paper does not state: "
@@ -314,15 +323,13 @@ def comparison_section(doc: Document, study: StudyArtefacts, data_dir, level: in
              "design points, so the surrogate is never integrated where it has no data); the last column gives "
              "the exact indices over the paper's Table 3 bounds for comparison.")
     rows = []
-    for r in pub.itertuples():
-        if r.unit not in study.units:
-            continue
-        what, ours, other = _ours(study.drive(r.unit), r.statistic, r.parameter)
+    compared = _published_against_ours(study, data_dir)
+    for r, what, ours, other in compared:
         rows.append([UNIT_NAMES[r.unit], what, math_label(r.parameter) if r.parameter else "", fmt(r.value),
                      fmt(ours), fmt(ours - r.value), other, lit(r.source)])
     doc.table(["drive", "statistic", "param.", "paper", "ours", "difference", "ours, paper Table 3 bounds", "paper source"],
               rows, "Replication of the paper's published statistics.")
-    worst = largest_sobol_difference(study, data_dir)
+    worst = _largest_sobol_difference(compared)
     if worst:
         doc.text("Largest difference of a Sobol' index from the paper's: " +
                  ", ".join(f"{UNIT_NAMES[u]} {fmt(v, 4)}" for u, v in worst.items()) + ".")
