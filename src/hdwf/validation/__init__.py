@@ -10,6 +10,8 @@ One module per idea, in the order a campaign uses them:
 * ``synthesis``: synthetic specimens, curves and noise (``hdwf synth``), design ranges;
 * ``observations``: measured values as one vector, and the model's value of each;
 * ``comparison``: comparison error, validation uncertainty, residual tests, BIC and the verdict;
+* ``signature``: the baseline's residual split into named terms (level, compliance, play, loop,
+  trends), read against ``noise``: the stated uncertainty against the data's own scatter;
 * ``calibration``: effect responses, joint least-squares calibration, re-solves near an
   estimate, leave-one-specimen-out error;
 * ``detectability``: which candidates data at a given noise could show (``hdwf plan``);

@@ -40,7 +40,8 @@ from hdwf.validation.detectability import Visibility, detectability
 from hdwf.validation.effects import get as get_effect
 from hdwf.validation.measurements import Measurements
 from hdwf.validation.observations import observation_frame, predict, prediction_points
-from hdwf.validation.signature import NoiseCheck, ResidualSignature, residual_signature, with_verdict
+from hdwf.validation.noise import NoiseCheck
+from hdwf.validation.signature import ResidualSignature, residual_signature, with_verdict
 from hdwf.validation.variants import candidate_names, variant_key
 
 

@@ -15,8 +15,7 @@ signature"):
   same sign, interpolated at the same |T|): the measured loop minus the model's, over all pairs and
   per torque level;
 * ``trend_<param>``: slope of the per-specimen mean r on each input (arcmin per µm) and its R²;
-* noise: the median stated u against an estimate from the data (second differences along each
-  branch, or the scatter after the inputs' regression), flagged ``NOISE_FLAG_RATIO`` below it.
+* noise: the median stated u against an estimate from the data (``hdwf.validation.noise``).
 
 The dominant term is the significant one largest against its se (statsmodels OLS fits).
 """
@@ -32,9 +31,9 @@ import statsmodels.api as sm
 
 from hdwf import PARAMETER_COLUMNS
 from hdwf.validation.comparison import Ranked, branches
+from hdwf.validation.noise import NoiseCheck, noise_check, noise_estimate
 
 SIGNIFICANT_Z = 3.0        # a term is significant beyond this many standard errors
-NOISE_FLAG_RATIO = 3.0     # a stated uncertainty this many times below the data's scatter is flagged
 FAILS_RATIO = 2.0          # the model "fails" when its RMSE exceeds the noise this many times
 
 _PHRASES = {
@@ -106,26 +105,6 @@ class LoopLevel:
     se_arcmin: float
     n: int
     significant: bool
-
-
-@dataclass(frozen=True)
-class NoiseCheck:
-    """The stated uncertainty against the scatter estimated from the data (``flag``: the stated one is
-    absent, zero or more than ``NOISE_FLAG_RATIO`` below the estimate; ``note`` says so in words)."""
-
-    stated_median_arcmin: float | None   # the median stated u, None when the data state none
-    estimate_arcmin: float | None        # None when the data cannot give one
-    estimate_from: str
-    n_used: int                          # second differences, or residual degrees of freedom, behind it
-    flag: bool
-    note: str                            # "" without a flag
-
-    @property
-    def reference_arcmin(self) -> float | None:
-        """The noise the signature is read against: the stated one unless flagged, else the estimate."""
-        if not self.flag and self.stated_median_arcmin:
-            return self.stated_median_arcmin
-        return self.estimate_arcmin if self.estimate_arcmin else self.stated_median_arcmin or None
 
 
 @dataclass(frozen=True)
@@ -317,75 +296,6 @@ def _trends(points: pd.DataFrame, r: np.ndarray) -> list[SignatureTerm]:
     return out
 
 
-def _second_differences(c: pd.DataFrame) -> np.ndarray:
-    """r[i-1] - 2 r[i] + r[i+1] along every branch of every specimen, leaving out the points before
-    any load (a loop or a play error, constant along a branch, then adds nothing)."""
-    out = []
-    for _, g in c.groupby("specimen_id", sort=False):
-        r, br, side = g["r"].to_numpy(float), g["branch"].to_numpy(), g["side"].to_numpy(float)
-        start = 0
-        for k in range(1, len(g) + 1):
-            if k < len(g) and br[k] == br[k - 1]:
-                continue
-            x = r[[i for i in range(start, k) if side[i] != 0]]
-            if len(x) >= 3:
-                out.append(x[:-2] - 2.0 * x[1:-1] + x[2:])
-            start = k
-    return np.concatenate(out) if out else np.zeros(0)
-
-
-def _noise_estimate(points: pd.DataFrame, c: pd.DataFrame | None, r: np.ndarray) -> tuple[float | None, str, int]:
-    """The noise from the data: second differences (curves) or the scatter after the inputs' regression."""
-    if c is not None:
-        d2 = _second_differences(c)
-        if d2.size:
-            return (float(np.sqrt(np.mean(d2 ** 2) / 6.0)),
-                    "second differences of D - S along each branch (var = 6 sigma^2)", int(d2.size))
-        return None, "too few points per branch for second differences", 0
-    cols = [p for p in PARAMETER_COLUMNS if p in points and np.ptp(points[p].to_numpy(float)) > 0]
-    X = points[cols].to_numpy(float) * 1000.0
-    if "quantity" in points and points["quantity"].nunique() > 1:
-        X = np.column_stack([X, pd.get_dummies(points["quantity"], drop_first=True, dtype=float).to_numpy()])
-    X = sm.add_constant(X, has_constant="add")
-    if len(r) - X.shape[1] < 3 or np.linalg.matrix_rank(X) < X.shape[1]:
-        return None, "too few values for the scatter after the regression on the inputs", 0
-    fit = sm.OLS(r, X).fit()
-    return (float(np.sqrt(fit.ssr / fit.df_resid)), "scatter of D - S after its regression on the inputs",
-            int(fit.df_resid))
-
-
-def noise_check(stated: np.ndarray, estimate: float | None, estimate_from: str, n_used: int) -> NoiseCheck:
-    """The stated uncertainty against the data's scatter, flagged when absent, zero or far below it.
-
-    Parameters
-    ----------
-    stated : numpy.ndarray
-        The stated uncertainty per value (NaN where none).
-    estimate : float or None
-        The noise estimated from the data.
-    estimate_from, n_used
-        How, and from how many values.
-
-    Returns
-    -------
-    NoiseCheck
-        With the note the report prints (when flagged, the diagnosis judges detectability by the estimate).
-    """
-    u = np.asarray(stated, float)
-    med = float(np.median(u[np.isfinite(u)])) if np.isfinite(u).any() else None
-    if not estimate or (med is not None and med * NOISE_FLAG_RATIO >= estimate):
-        return NoiseCheck(med, estimate, estimate_from, n_used, False, "")
-    if med is None:
-        note = (f"no uncertainty is stated; the scatter estimated from the data is {estimate:.3g} arcmin "
-                "(the detectability uses the final model's residual instead, an upper bound)")
-        return NoiseCheck(med, estimate, estimate_from, n_used, True, note)
-    note = (f"stated uncertainty {med:.3f} arcmin is far below the scatter {estimate:.3g} arcmin estimated from "
-            "the data; the estimate is used to read this signature and to judge what the data can show (the "
-            "detectability table). The verdict (ΔBIC, leave-one-out error) does not use the stated uncertainty; "
-            "u_val does, so it understates the comparison's uncertainty")
-    return NoiseCheck(med, estimate, estimate_from, n_used, True, note)
-
-
 def residual_signature(points: pd.DataFrame, form: str) -> ResidualSignature:
     """The signature of the residual D − S on a diagnosis's comparison points.
 
@@ -407,7 +317,7 @@ def residual_signature(points: pd.DataFrame, form: str) -> ResidualSignature:
     is_curve = form == "curve" and "torque_Nm" in points and "step" in points
     c, t_test, tol = _curve_frame(points) if is_curve else (None, None, 0.0)
     noise = noise_check(points["u_D"].to_numpy(float) if "u_D" in points else np.full(len(r), np.nan),
-                        *_noise_estimate(points, c, r))
+                        *noise_estimate(points, c, r))
     terms, levels, left_out = [_bias(r, form)], (), {}
     if c is not None:
         loop, levels = _loop(c, tol)
