@@ -15,7 +15,7 @@ from hdwf import __version__
 from hdwf.common.errors import ConfigError, InputError, SolveFailed
 from hdwf.common.io import atomic_path
 from hdwf.common.provenance import config_hash, provenance
-from hdwf.config import SCHEMA_PATH, blame, load_config
+from hdwf.config import SCHEMA_PATH, blame, fe_option_bounds, load_config
 from hdwf.stages.validation import campaign_plan, campaign_specimens
 from hdwf.study.paper import PAPER_TABLES, paper_measurements
 from hdwf.validation.detectability import plan_detectability
@@ -132,6 +132,11 @@ def _bounded(kind: type, low: float, high: float, low_open: bool = False):
     return parse
 
 
+def _fe_option(kind: type, name: str):
+    """An argparse type bounded as the config schema bounds ``fe.<name>``."""
+    return _bounded(kind, *fe_option_bounds(name))
+
+
 def _specimen_options(p, seed_help: str, noise_help: str) -> None:
     p.add_argument("--unit", required=True, choices=["hd42", "hd120"])
     p.add_argument("--designs", type=_bounded(int, 1, 1000), required=True, help="number of specimens")
@@ -158,13 +163,13 @@ def _design_ranges(args) -> dict[str, tuple[float, float]]:
 
 
 def _solve_options(p, elements_over_height: int, elements_over_thickness: int, mesh_is: str) -> None:
-    p.add_argument("--elements-over-height", type=_bounded(int, 2, 40), default=elements_over_height,
+    p.add_argument("--elements-over-height", type=_fe_option(int, "elements_over_height"), default=elements_over_height,
                    help=f"elements over a tooth's height (default %(default)s: {mesh_is})")
-    p.add_argument("--elements-over-thickness", type=_bounded(int, 2, 30), default=elements_over_thickness,
+    p.add_argument("--elements-over-thickness", type=_fe_option(int, "elements_over_thickness"), default=elements_over_thickness,
                    help=f"elements over a tooth's thickness (default %(default)s: {mesh_is})")
-    p.add_argument("--refinement", type=_bounded(float, 0, 4, low_open=True), default=1.0,
+    p.add_argument("--refinement", type=_fe_option(float, "refinement"), default=1.0,
                    help="multiplies both element counts (default %(default)s)")
-    p.add_argument("--steps-per-ramp", type=_bounded(int, 1, 50), default=5,
+    p.add_argument("--steps-per-ramp", type=_fe_option(int, "steps_per_ramp"), default=5,
                    help="load steps on each ramp of 0 -> +T -> 0 -> -T -> 0 (default %(default)s)")
     p.add_argument("--jobs", type=_bounded(int, 1, 256), default=1,
                    help="processes, one specimen each (default %(default)s)")
@@ -267,8 +272,8 @@ def _check_measurements(args) -> int:
     return 0
 
 
-def main(argv=None) -> int:
-    """Run the ``hdwf`` command ``argv`` (default: the process's arguments); its exit status."""
+def build_parser() -> argparse.ArgumentParser:
+    """The ``hdwf`` command line: every subcommand with its options and limits."""
     parser = argparse.ArgumentParser(prog="hdwf", description="Harmonic-drive lost-motion study tools.")
     parser.add_argument("--version", action="version", version=f"hdwf {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -296,7 +301,7 @@ def main(argv=None) -> int:
     p.add_argument("--unit", choices=["hd42", "hd120"],
                    help="the drive the file is for: adds a campaign's checks (every specimen of it, ids that "
                         "can name files); without it the file's own drives are taken")
-    p.add_argument("--steps-per-ramp", type=_bounded(int, 1, 50), default=5,
+    p.add_argument("--steps-per-ramp", type=_fe_option(int, "steps_per_ramp"), default=5,
                    help="the campaign's load steps per ramp: a curve point beyond its test torque by more than "
                         "a quarter of a step is refused (default 5, the config's)")
     p.set_defaults(func=_check_measurements)
@@ -323,7 +328,12 @@ def main(argv=None) -> int:
     p.add_argument("--force", action="store_true", help="replace an existing output file")
     _solve_options(p, 5, 3, "the shipped campaigns' coarse mesh")
     p.set_defaults(func=_plan)
-    args = parser.parse_args(argv)
+    return parser
+
+
+def main(argv=None) -> int:
+    """Run the ``hdwf`` command ``argv`` (default: the process's arguments); its exit status."""
+    args = build_parser().parse_args(argv)
     try:
         return args.func(args)
     except InputError as exc:

@@ -21,6 +21,17 @@ from hdwf.validation.effects import registry
 SCHEMA_PATH = Path(__file__).with_name("config.schema.yaml")
 
 
+def fe_option_bounds(name: str, schema_path: str | Path = SCHEMA_PATH) -> tuple[float, float, bool]:
+    """The schema's limits of the ``fe`` section's option ``name``: (low, high, low excluded).
+
+    The CLI's mesh and load options take them from here, so a command line accepts what a
+    config accepts and no more.
+    """
+    prop = yaml.safe_load(Path(schema_path).read_text())["properties"]["fe"]["properties"][name]
+    low_open = "exclusiveMinimum" in prop
+    return prop["exclusiveMinimum" if low_open else "minimum"], prop["maximum"], low_open
+
+
 def _key_path(error: jsonschema.ValidationError) -> str:
     return ".".join(str(p) for p in error.absolute_path) or "(top level)"
 

@@ -107,7 +107,8 @@ def test_synth_whose_solve_fails_says_so_without_a_traceback_and_writes_nothing(
 @pytest.mark.parametrize("option, value, said", [
     ("--designs", "0", "'0' is outside [1, 1000]"), ("--seed", "-1", "'-1' is outside [0, 4294967295]"),
     ("--noise-arcmin", "inf", "'inf' is outside [0.0, 60.0]"), ("--refinement", "nan", "'nan' is outside (0.0, 4.0]"),
-    ("--steps-per-ramp", "0", "'0' is outside [1, 50]"), ("--elements-over-height", "1", "'1' is outside [2, 40]"),
+    ("--steps-per-ramp", "0", "'0' is outside [1, 200]"), ("--steps-per-ramp", "201", "'201' is outside [1, 200]"),
+    ("--elements-over-height", "1", "'1' is outside [2, 40]"),
     ("--jobs", "0", "'0' is outside [1, 256]"), ("--designs", "two", "'two' is not a whole number")])
 def test_synth_and_plan_refuse_options_outside_the_schemas_limits_before_any_solve(tmp_path, capsys, option, value, said):
     """The mesh and load options carry the config schema's limits (a mesh of 0 elements was
