@@ -163,9 +163,11 @@ def _design_ranges(args) -> dict[str, tuple[float, float]]:
 
 
 def _solve_options(p, elements_over_height: int, elements_over_thickness: int, mesh_is: str) -> None:
-    p.add_argument("--elements-over-height", type=_fe_option(int, "elements_over_height"), default=elements_over_height,
+    p.add_argument("--elements-over-height", type=_fe_option(int, "elements_over_height"),
+                   default=elements_over_height,
                    help=f"elements over a tooth's height (default %(default)s: {mesh_is})")
-    p.add_argument("--elements-over-thickness", type=_fe_option(int, "elements_over_thickness"), default=elements_over_thickness,
+    p.add_argument("--elements-over-thickness", type=_fe_option(int, "elements_over_thickness"),
+                   default=elements_over_thickness,
                    help=f"elements over a tooth's thickness (default %(default)s: {mesh_is})")
     p.add_argument("--refinement", type=_fe_option(float, "refinement"), default=1.0,
                    help="multiplies both element counts (default %(default)s)")

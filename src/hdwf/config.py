@@ -6,6 +6,7 @@ reads the file, the dotted key path, the value and what was expected.
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 from collections.abc import Iterator
@@ -21,13 +22,18 @@ from hdwf.validation.effects import registry
 SCHEMA_PATH = Path(__file__).with_name("config.schema.yaml")
 
 
+@functools.lru_cache(maxsize=4)
+def _schema(path: str) -> dict:
+    return yaml.safe_load(Path(path).read_text())
+
+
 def fe_option_bounds(name: str, schema_path: str | Path = SCHEMA_PATH) -> tuple[float, float, bool]:
     """The schema's limits of the ``fe`` section's option ``name``: (low, high, low excluded).
 
     The CLI's mesh and load options take them from here, so a command line accepts what a
     config accepts and no more.
     """
-    prop = yaml.safe_load(Path(schema_path).read_text())["properties"]["fe"]["properties"][name]
+    prop = _schema(str(schema_path))["properties"]["fe"]["properties"][name]
     low_open = "exclusiveMinimum" in prop
     return prop["exclusiveMinimum" if low_open else "minimum"], prop["maximum"], low_open
 
