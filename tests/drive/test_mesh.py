@@ -103,3 +103,24 @@ def test_flank_refinement_divides_only_the_flanks(geom):
         assert added == (z // 2) * 2 * n
     with pytest.raises(ValueError, match="flank_refinement"):
         build_mesh(geom, **COARSE, symmetry="half", bodies=("fs",), flank_refinement=0.0)
+
+
+@pytest.mark.parametrize("unit, offsets, interference_m, tip_relief, said", [
+    # HD 42 Table 4 set 27: an allowance of 0.4 m makes neighbouring FS teeth meet at the root
+    ("hd42", (31.0085925926, 41.9985185185, 0.0147222222, 0.0003703704, 0.0077777778), 0.4, 3.0, "FS space only -0.00"),
+    # HD 120 at 3 times the derived relief: the CS tips are relieved to 0.037 m
+    ("hd120", (90.0, 120.0, 0.03, 0.025, 0.025), 0.3, 3.0, "CS tooth only 0.037 m wide")])
+def test_an_outline_too_narrow_to_mesh_is_refused_before_gmsh(unit, offsets, interference_m, tip_relief, said):
+    """gmsh never returned on these two outlines (the solve of a benchmark hung for minutes): the
+    mesh now refuses a tooth or space narrower than 0.1 m with its width, place and cause."""
+    g = drive_geometry(unit, *offsets, interference_m=interference_m, tip_relief=tip_relief)
+    with pytest.raises(ValueError, match="at least 0.1 m is meshed") as err:
+        build_mesh(g, symmetry="half", **COARSE)
+    assert said in str(err.value) and f"interference_m={interference_m:g}" in str(err.value)
+
+
+def test_the_narrowest_outline_of_the_studies_meshes():
+    """Over Table 3's offsets with the studies' allowance (0.3 m, relief 1.1) the narrowest feature
+    is HD 42's FS root space at r_FS = 0, r_CS = 0.02 mm: about 0.21 m, twice the refusal limit."""
+    g = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.0, 0.02, interference_m=0.3, tip_relief=1.1)
+    assert build_mesh(g, symmetry="half", bodies=("fs",), **COARSE).bodies["fs"].mesh.p.shape[1] > 1000
