@@ -1,4 +1,5 @@
-"""CI must prove what a newcomer runs: .ci/run holds the README's test command verbatim."""
+"""CI must prove what a newcomer runs: .ci/run holds the README's test command verbatim, and every
+hdwf command line the README and docs give is accepted by the CLI as written."""
 
 import re
 import shlex
