@@ -24,6 +24,7 @@ SCHEMA_PATH = Path(__file__).with_name("config.schema.yaml")
 
 @functools.lru_cache(maxsize=4)
 def _schema(path: str) -> dict:
+    """The schema file, read once per process (never modified: defaults are copied out of it)."""
     return yaml.safe_load(Path(path).read_text())
 
 
@@ -121,7 +122,7 @@ def _check_schema(config: dict, schema_path: str | Path, source) -> None:
     nan_at = _not_a_number(config)
     if nan_at:
         raise ConfigError(source, "not a number (NaN): give a value", field=nan_at, value=float("nan"))
-    schema = yaml.safe_load(Path(schema_path).read_text())
+    schema = _schema(str(schema_path))
     validator_cls = jsonschema.validators.validator_for(schema)
     # Fill defaults so downstream code never meets a missing optional key.
     def set_defaults(validator, properties, instance, schema_):

@@ -108,11 +108,12 @@ def test_flank_refinement_divides_only_the_flanks(geom):
 @pytest.mark.parametrize("unit, offsets, interference_m, tip_relief, said", [
     # HD 42 Table 4 set 27: an allowance of 0.4 m makes neighbouring FS teeth meet at the root
     ("hd42", (31.0085925926, 41.9985185185, 0.0147222222, 0.0003703704, 0.0077777778), 0.4, 3.0, "FS space only -0.00"),
-    # HD 120 at 3 times the derived relief: the CS tips are relieved to 0.037 m
+    # HD 120 at 3 times the derived relief: the CS tips are relieved to 0.037 m (at hd120-lhs-11's
+    # larger r_CS to nothing, -0.002 m, where gmsh never returned)
     ("hd120", (90.0, 120.0, 0.03, 0.025, 0.025), 0.3, 3.0, "CS tooth only 0.037 m wide")])
 def test_an_outline_too_narrow_to_mesh_is_refused_before_gmsh(unit, offsets, interference_m, tip_relief, said):
-    """gmsh never returned on these two outlines (the solve of a benchmark hung for minutes): the
-    mesh now refuses a tooth or space narrower than 0.1 m with its width, place and cause."""
+    """gmsh never returned on such outlines (a benchmark's solve hung for minutes): the mesh now
+    refuses a tooth or space narrower than 0.1 m with its width, place and cause."""
     g = drive_geometry(unit, *offsets, interference_m=interference_m, tip_relief=tip_relief)
     with pytest.raises(ValueError, match="at least 0.1 m is meshed") as err:
         build_mesh(g, symmetry="half", **COARSE)

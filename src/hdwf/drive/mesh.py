@@ -51,7 +51,7 @@ MESH_ALGORITHM = 6   # gmsh 2D: 6 = Frontal-Delaunay (quality); 5 = Delaunay
 LC_INTEGRATION_PRECISION = 1e-6   # relative precision of the size integral along a curve
 # narrower teeth or spaces (units of the module) are refused: gmsh never returns on a tooth
 # period whose neighbouring FS teeth meet at the root (HD 42 Table 4 set 27 at an allowance of
-# 0.4 m) or on CS tips relieved to 0.04 m (HD 120, 3 times the derived relief)
+# 0.4 m) or whose CS tips are relieved away (hd120-lhs-11 at 3 times the derived relief)
 MIN_FEATURE_M = 0.1
 
 
