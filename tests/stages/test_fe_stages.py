@@ -9,7 +9,7 @@ import pytest
 
 from hdwf.drive.design import MeshSettings, geometry_of
 from hdwf.fe import solve_lost_motion
-from hdwf.stages.fe import DesignOutputs, refined_solve_stage, solve_stage
+from hdwf.stages.fe_solve import DesignOutputs, refined_solve_stage, solve_stage
 from hdwf.validation.effects import model_changes
 
 # HD 42, Table 3's nominal bearing, r_FS = r_CS = 5 µm

@@ -50,7 +50,7 @@ def test_a_coned_variant_of_a_campaign_table_takes_series_elements_exactly():
     K = 6.0e4    # N m / rad
     coned = {**fixed, "coning": {"slope": 0.2}}
     table = solve_specimen(SolveSetup("hd42", MESH, steps_per_ramp=1), SPECIMEN,
-                           [fixed, coned, {**coned, "fs_cup_torsion": {"K_Nm_per_rad": K}}])
+                           [fixed, coned, {**coned, "fs_cup_torsion": {"K_Nm_per_rad": K}}]).to_pandas()
     assert (table["status"] == "ok").all(), table["status"].unique()
     curves = [g.sort_values("step") for _, g in table.groupby("variant", sort=False)]
     section, cone, cone_cup = (c["twist_arcmin"].to_numpy() for c in curves)

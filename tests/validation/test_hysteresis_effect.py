@@ -193,7 +193,7 @@ def table(request):
     values = sorted({p.lower, p.realistic_for(unit), *p.grid(), p.upper})
     variants = [{}] + [{NAME: {PARAM: v}} for v in values] + [
         {NAME: {PARAM: p.realistic_for(unit)}, "fs_cup_torsion": {"K_Nm_per_rad": k_cup}}]
-    tab = solve_specimen(SolveSetup(unit, SETTINGS, STEPS), SPECIMENS[unit], variants)
+    tab = solve_specimen(SolveSetup(unit, SETTINGS, STEPS), SPECIMENS[unit], variants).to_pandas()
     curves = {variant_key(v): tab[tab["variant"] == variant_key(v)] for v in variants}
     return unit, values, k_cup, curves
 

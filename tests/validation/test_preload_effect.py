@@ -46,7 +46,7 @@ def test_preload_variants_equal_their_own_solves_and_take_the_clearance_up():
     thicken."""
     setup = SolveSetup("hd42", MESH, steps_per_ramp=1)
     variants = [{}, {"preload": {"interference_m": 0.05}}, {"preload": {"interference_m": 0.1}}]
-    table = solve_specimen(setup, SPECIMEN, variants)
+    table = solve_specimen(setup, SPECIMEN, variants).to_pandas()
     assert (table["status"] == "ok").all(), table["status"].unique()
     phi = {}
     for key, part in table.groupby("variant", sort=False):

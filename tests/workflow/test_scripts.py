@@ -29,3 +29,18 @@ def test_a_script_runs_outside_snakemake_from_any_folder(tmp_path):
     assert table["lost_motion_arcmin"].tolist() == published["lost_motion_arcmin"].tolist()
     assert "wrote results/paper/hd42/lost_motion.parquet" in (project / "results/logs/paper_hd42_lost_motion.log").read_text()
     assert not any(elsewhere.iterdir())
+
+
+@pytest.mark.parametrize("script, stage", [("fe_solve.py", "fe_solve"), ("fe_refined_solve.py", "fe_solve"),
+                                           ("validation_specimen.py", "validation_specimen")])
+def test_a_solve_job_starts_without_pandas(script, stage):
+    """Some 240 solve jobs of the default target each start a Python; importing pandas added
+    ~0.25 s to every one (docs/fe-model.md, Time), so what these scripts import must not pull it in."""
+    source = (ROOT / "workflow/scripts" / script).read_text()
+    imports = [line for line in source.splitlines() if line.startswith(("import ", "from "))]
+    assert any(f"hdwf.stages.{stage} import" in line for line in imports)
+    code = "\n".join(["import sys", f"sys.path.insert(0, {str(ROOT / 'workflow/scripts')!r})", *imports,
+                      "print(sorted(m for m in ('pandas', 'matplotlib', 'statsmodels') if m in sys.modules))"])
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr[-3000:]
+    assert run.stdout.strip() == "[]"

@@ -3,7 +3,7 @@ import logging
 
 from _helpers import mock_snakemake, setup
 
-from hdwf.stages.fe import refined_solve_stage
+from hdwf.stages.fe_solve import refined_solve_stage
 
 if "snakemake" not in globals():  # run by hand, e.g. to debug one step (see _helpers.mock_snakemake)
     snakemake = mock_snakemake("fe_refined_solve", study="fe", unit="hd42", design="hd42-lhs-01", ref="1.25")

@@ -13,13 +13,16 @@ import os
 import tempfile
 from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING, Mapping
 
 import numpy as np
-import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
 from hdwf.common.errors import InputError
+
+if TYPE_CHECKING:   # pandas is imported where a table is read: a solve job writes Arrow and never needs it
+    import pandas as pd
 
 PROVENANCE_KEY = b"hdwf.provenance"
 EXTRA_KEY = b"hdwf.meta"
@@ -72,10 +75,24 @@ def unit_of(column: str) -> str | None:
     return None
 
 
-def write_parquet(df: pd.DataFrame, path: str | Path, *, provenance: dict | None = None,
+def arrow_table(columns: Mapping[str, object]) -> pa.Table:
+    """An Arrow table from ``{column: sequence}``, NaN stored as null as ``pandas`` stores it."""
+    return pa.table({name: pa.array(values, from_pandas=True) for name, values in columns.items()})
+
+
+def arrow_row(row: Mapping[str, object]) -> pa.Table:
+    """A one-row Arrow table from ``{column: value}`` (``arrow_table``)."""
+    return arrow_table({name: [value] for name, value in row.items()})
+
+
+def write_parquet(df: pd.DataFrame | pa.Table, path: str | Path, *, provenance: dict | None = None,
                   meta: dict | None = None, schema: pa.Schema | None = None) -> Path:
-    """Write ``df`` atomically; units from column names go into the Arrow field metadata."""
-    table = pa.Table.from_pandas(df, schema=schema, preserve_index=False)
+    """Write ``df`` (a DataFrame or an Arrow table) atomically; units from column names go into the
+    Arrow field metadata."""
+    if isinstance(df, pa.Table):
+        table = df if schema is None else df.cast(schema)
+    else:
+        table = pa.Table.from_pandas(df, schema=schema, preserve_index=False)
     fields = []
     for field in table.schema:
         unit = unit_of(field.name)
@@ -128,6 +145,8 @@ def read_table(path: str | Path, required: dict[str, str]) -> pd.DataFrame:
     Raises InputError naming the file, the 1-based data row and the column of the first
     bad value; a missing column is named with the columns that were found.
     """
+    import pandas as pd
+
     path = Path(path)
     if not path.exists():
         raise InputError(path, "file not found")

@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 from typing import Mapping
 
-import pandas as pd
+import pyarrow.parquet as pq
 
 from hdwf import PARAMETER_COLUMNS
 from hdwf.drive.geometry import DriveGeometry, drive_geometry
@@ -50,11 +50,11 @@ class MeshSettings:
 
 def design_parameters(designs_path, design_id: str) -> dict[str, float]:
     """The five parameters (``d_mm`` … ``rCS_mm``) of one design of a design table."""
-    df = pd.read_parquet(designs_path)
-    row = df[df["design_id"] == design_id]
-    if len(row) != 1:
-        raise KeyError(f"{designs_path}: design '{design_id}' not found (have {len(df)} designs)")
-    return {c: float(row.iloc[0][c]) for c in PARAMETER_COLUMNS}
+    table = pq.read_table(designs_path, columns=["design_id", *PARAMETER_COLUMNS]).to_pydict()
+    rows = [i for i, d in enumerate(table["design_id"]) if d == design_id]
+    if len(rows) != 1:
+        raise KeyError(f"{designs_path}: design '{design_id}' not found (have {len(table['design_id'])} designs)")
+    return {c: float(table[c][rows[0]]) for c in PARAMETER_COLUMNS}
 
 
 def geometry_of(unit: str, params: Mapping[str, float], interference_m: float = 0.0,

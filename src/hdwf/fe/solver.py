@@ -434,7 +434,7 @@ class ContactSolver:
         the Hertz loop forms u once from its last outcome.  With friction the tangential
         forces add their own columns to u, so u is formed and G applied to it."""
         system = level.kkt(block)
-        nA, nS, nm = len(block.pairs), system.n_tangential, block.mode_rows.shape[1]
+        nA, nS = len(block.pairs), system.n_tangential
         M = system.matrix
         M[nA + nS:, nA + nS:] = problem.mode_block     # (``_control``)
         if isinstance(level, FrictionlessLevel):

@@ -1,5 +1,6 @@
 """Stages of the validation campaigns (rules in ``workflow/rules/validation.smk``): a campaign's
-plan from the config, the per-specimen tables, the diagnosis, the ladder and the figures.
+plan from the config, the diagnosis, the ladder and the figures.  The per-specimen tables (a job
+each) are ``hdwf.stages.validation_specimen``.
 
 Each stage reads its inputs, calls ``hdwf.validation`` and writes what its rule promises.
 """
@@ -7,7 +8,7 @@ Each stage reads its inputs, calls ``hdwf.validation`` and writes what its rule 
 from __future__ import annotations
 
 # The figures (matplotlib) and the diagnosis (statsmodels) are imported by the stages that use
-# them: the 70 specimen jobs of a default run then start a second faster each.
+# them: the Snakefile imports this module to plan the campaigns, and the ladder needs neither.
 
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,7 +20,7 @@ from hdwf.common.io import read_json, write_json, write_parquet
 from hdwf.validation.jsonsafe import json_safe
 from hdwf.validation.ladder import ladder_variants, solve_ladder
 from hdwf.validation.measurements import MeasurementError, load_measurements, schedule_problems
-from hdwf.validation.variants import SolveSetup, candidate_names, plan_variants, solve_specimen, specimen_solver
+from hdwf.validation.variants import SolveSetup, candidate_names, plan_variants, specimen_solver
 
 if TYPE_CHECKING:
     from hdwf.validation.diagnosis import Search
@@ -149,33 +150,6 @@ def specimen_record(specimens: pd.DataFrame, specimen_id: str) -> dict:
     row = specimens[specimens["specimen_id"] == specimen_id].iloc[0]
     return {k: (float(v) if k.endswith("_mm") else str(v)) for k, v in row.items()
             if k in ("specimen_id", "unit") or k.endswith("_mm")}
-
-
-def specimen_stage(setup: SolveSetup, specimen: dict, variants: list[dict], out, provenance: dict) -> pd.DataFrame:
-    """Mesh one specimen once and solve it for every variant: its campaign table.
-
-    Parameters
-    ----------
-    setup : SolveSetup
-        Drive, mesh settings and load steps.
-    specimen : dict
-        ``specimen_id`` and the parameter columns (``specimen_record``).
-    variants : list of dict
-        The campaign's variants (``CampaignPlan.table_variants``).
-    out : path
-        The table (Parquet).
-    provenance : dict
-        Stamped on the table.
-
-    Returns
-    -------
-    pandas.DataFrame
-        The table written.
-    """
-    table = solve_specimen(setup, specimen, variants)
-    write_parquet(table, out, provenance=provenance,
-                  meta={"unit": setup.unit, "specimen_id": specimen["specimen_id"], "mesh": setup.mesh})
-    return table
 
 
 def diagnosis_stage(plan: CampaignPlan, inputs: CampaignInputs, out_json, out_points, provenance: dict,

@@ -5,7 +5,9 @@ from __future__ import annotations
 from typing import Mapping
 
 import numpy as np
-import pandas as pd
+import pyarrow as pa
+
+from hdwf.common.io import arrow_table
 
 from hdwf.drive.design import geometry_of
 from hdwf.drive.mesh import DriveMesh
@@ -16,7 +18,7 @@ CURVE_COLUMNS = ["design_id", "step", "torque_Nm", "twist_arcmin"]
 
 
 def solve_design(unit: str, params: Mapping[str, float], mesh: DriveMesh, steps_per_ramp: int, design_id: str,
-                 changes: ModelChanges | None = None, **solver_options) -> tuple[dict, pd.DataFrame]:
+                 changes: ModelChanges | None = None, **solver_options) -> tuple[dict, pa.Table]:
     """Solve one design; return its lost-motion row and its torque–twist curve.
 
     Parameters
@@ -48,7 +50,7 @@ def solve_design(unit: str, params: Mapping[str, float], mesh: DriveMesh, steps_
            "ball_load_max_N": float(res.max_ball_load_N), "ball_pressure_max_MPa": float(res.max_ball_pressure_MPa),
            "iterations": int(res.iterations), "n_dofs": int(res.n_dofs), "solve_s": float(res.solve_s),
            "factorize_s": float(res.factorize_s), "h_tooth_mm": float(mesh.sizes.get("tooth", np.nan))}
-    curve = pd.DataFrame({"design_id": design_id, "step": np.asarray(res.step, dtype="int64"),
-                          "torque_Nm": np.asarray(res.torque_Nm, float),
-                          "twist_arcmin": np.asarray(res.twist_arcmin, float)}, columns=CURVE_COLUMNS)
+    step = np.asarray(res.step, dtype="int64")
+    curve = arrow_table(dict(zip(CURVE_COLUMNS, ([design_id] * step.size, step, np.asarray(res.torque_Nm, float),
+                                                 np.asarray(res.twist_arcmin, float)))))
     return row, curve

@@ -32,13 +32,14 @@ import sys
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
-from typing import Callable, Mapping
+from typing import TYPE_CHECKING, Callable, Mapping
 
 import numpy as np
-import pandas as pd
+import pyarrow as pa
 from tqdm import tqdm
 
 from hdwf import PARAMETER_COLUMNS
+from hdwf.common.io import arrow_table
 from hdwf.drive.design import MeshSettings, geometry_of
 from hdwf.drive.geometry import ARCMIN, DriveGeometry
 from hdwf.drive.mesh import share_bodies
@@ -46,6 +47,9 @@ from hdwf.fe import ModelChanges, series_output_twist, solve_lost_motion_variant
 from hdwf.fe.model import SharedBodies
 from hdwf.validation.effects import get as get_effect
 from hdwf.validation.effects import model_changes, registry
+
+if TYPE_CHECKING:   # a specimen's job (one specimen, an Arrow table out) starts without pandas
+    import pandas as pd
 
 BASELINE = "baseline"
 TABLE_COLUMNS = ["specimen_id", "variant", "step", "torque_Nm", "twist_arcmin", "status", "ball_pressure_max_MPa"]
@@ -156,7 +160,7 @@ def _series_shift_arcmin(torque_Nm: np.ndarray, changes: ModelChanges) -> np.nda
     return add - add[0]
 
 
-def solve_specimen(setup: SolveSetup, specimen: Mapping, variants: list[dict]) -> pd.DataFrame:
+def solve_specimen(setup: SolveSetup, specimen: Mapping, variants: list[dict]) -> pa.Table:
     """Mesh one specimen and solve it for every variant (one contact solve per distinct FE part).
 
     Parameters
@@ -170,9 +174,9 @@ def solve_specimen(setup: SolveSetup, specimen: Mapping, variants: list[dict]) -
 
     Returns
     -------
-    pandas.DataFrame
+    pyarrow.Table
         The specimen's table (``TABLE_COLUMNS``), variants in the given order. A variant whose
-        solve fails gets ``status = "failed: <reason>"`` and NaN twists.
+        solve fails gets ``status = "failed: <reason>"`` and no twists (null, NaN in pandas).
     """
     params = {c: float(specimen[c]) for c in PARAMETER_COLUMNS}
     settings = MeshSettings.from_mapping(setup.mesh)
@@ -206,13 +210,12 @@ def solve_specimen(setup: SolveSetup, specimen: Mapping, variants: list[dict]) -
             step = np.arange(4 * steps + 1)
             torque = np.full(step.size, np.nan)
             tw = np.full(step.size, np.nan)
-        frames.append(pd.DataFrame({
-            "specimen_id": specimen["specimen_id"], "variant": variant_key(eff),
-            "step": np.asarray(step, dtype="int64"), "torque_Nm": np.asarray(torque, float),
-            "twist_arcmin": np.asarray(tw, float),
-            "status": "ok" if ok else f"failed: {res.reason}",
-            "ball_pressure_max_MPa": float(res.max_ball_pressure_MPa) if ok else np.nan}))
-    return pd.concat(frames, ignore_index=True)[TABLE_COLUMNS]
+        n = len(step)
+        frames.append(arrow_table(dict(zip(TABLE_COLUMNS, (
+            [specimen["specimen_id"]] * n, [variant_key(eff)] * n, np.asarray(step, dtype="int64"),
+            np.asarray(torque, float), np.asarray(tw, float), ["ok" if ok else f"failed: {res.reason}"] * n,
+            np.full(n, float(res.max_ball_pressure_MPa) if ok else np.nan))))))
+    return pa.concat_tables(frames)
 
 
 def _fs_only_differs(geom: DriveGeometry, other: DriveGeometry) -> bool:
@@ -221,7 +224,7 @@ def _fs_only_differs(geom: DriveGeometry, other: DriveGeometry) -> bool:
     return replace(other, interference_m=geom.interference_m) == geom
 
 
-def _specimen_job(task: tuple[SolveSetup, dict, list[dict]]) -> pd.DataFrame:
+def _specimen_job(task: tuple[SolveSetup, dict, list[dict]]) -> pa.Table:
     return solve_specimen(*task)
 
 
@@ -277,7 +280,7 @@ def solve_specimens(setup: SolveSetup, specimens: pd.DataFrame,
                 for table in ex.map(_specimen_job, tasks):
                     out.append(table)
                     bar.update(1)
-    return pd.concat(out, ignore_index=True)
+    return pa.concat_tables(out).to_pandas()
 
 
 def specimen_solver(setup: SolveSetup, specimens: pd.DataFrame) -> Callable[[list[dict]], pd.DataFrame]:

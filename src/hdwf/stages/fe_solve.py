@@ -1,0 +1,72 @@
+"""The per-design stages of the FE studies (rules ``fe_solve`` and ``fe_refined_solve`` in
+``workflow/rules/fe.smk``): mesh and solve one design into its row and torque–twist curve.
+
+Some 170 such jobs run in the default target, each a fresh Python process; they write Arrow
+tables and never import pandas, which would add a quarter of a second to each one's start.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Mapping
+
+from hdwf.common.io import arrow_row, atomic_path, write_parquet
+from hdwf.drive.design import MeshSettings, design_parameters, geometry_of
+from hdwf.drive.mesh import DriveMesh
+from hdwf.study.fe_design import solve_design
+from hdwf.validation.effects import model_changes
+
+
+def design_model(designs_path, design_id: str, unit: str, effects: Mapping | None):
+    """One design's parameters, the study's switched-on changes (``fe.effects``) and the geometry
+    they shape (the preload thickens the teeth)."""
+    params = design_parameters(designs_path, design_id)
+    changes = model_changes(effects)
+    return params, changes, geometry_of(unit, params, **changes.geometry_part())
+
+
+def _mesh_to(geom, settings: Mapping, out_msh) -> DriveMesh:
+    """Mesh a design's geometry, writing gmsh's ``.msh`` for review; returns the mesh."""
+    with atomic_path(out_msh) as tmp_msh:
+        # gmsh picks the format from the extension, so the temporary name keeps ".msh".
+        tmp_named = tmp_msh.with_suffix(".msh")
+        mesh = MeshSettings.from_mapping(settings).mesh(geom, path=str(tmp_named))
+        tmp_named.replace(tmp_msh)
+    return mesh
+
+
+@dataclass(frozen=True)
+class DesignOutputs:
+    """Where one design's solve writes: its mesh (``.msh``), its row and its torque–twist curve."""
+    msh: str | Path
+    row: str | Path
+    curve: str | Path
+
+
+def solve_stage(designs_path, design_id: str, unit: str, settings: Mapping, steps_per_ramp: int,
+                out: DesignOutputs, provenance: dict, effects: Mapping | None = None) -> dict:
+    """Mesh one design and solve it into its row and torque–twist curve (Parquet each), with the
+    study's switched-on ``effects`` (``{name: {parameter: value}}``).  One job does both: the mesh
+    takes a second or two, less than a job of its own spends starting and passing it on."""
+    params, changes, geom = design_model(designs_path, design_id, unit, effects)   # the preload reshapes the outline
+    t0 = time.perf_counter()
+    mesh = _mesh_to(geom, settings, out.msh)
+    mesh_s = time.perf_counter() - t0
+    row, curve = solve_design(unit, params, mesh, steps_per_ramp, design_id, changes=changes)
+    row["mesh_s"] = mesh_s
+    write_parquet(arrow_row(row), out.row, provenance=provenance, meta={"unit": unit})
+    write_parquet(curve, out.curve, provenance=provenance, meta={"unit": unit})
+    return row
+
+
+def refined_solve_stage(designs_path, design_id: str, unit: str, settings: Mapping, steps_per_ramp: int, out,
+                        provenance: dict, effects: Mapping | None = None) -> dict:
+    """Mesh and solve one design at another refinement (mesh-convergence runs); one row out."""
+    params, changes, geom = design_model(designs_path, design_id, unit, effects)
+    row, _ = solve_design(unit, params, MeshSettings.from_mapping(settings).mesh(geom), steps_per_ramp, design_id,
+                          changes=changes)
+    row["refinement"] = float(settings["refinement"])
+    write_parquet(arrow_row(row), out, provenance=provenance, meta={"unit": unit})
+    return row
