@@ -10,7 +10,7 @@ import pytest
 from hdwf.stages.paper import paper_lost_motion_stage
 from hdwf.study.aggregate import write_lost_motion
 from hdwf.common.provenance import config_hash
-from hdwf.common.io import atomic_path, read_parquet_meta
+from hdwf.common.io import arrow_row, atomic_path, read_parquet_meta, write_parquet
 from hdwf.common.provenance import provenance
 
 from conftest import ROOT
@@ -100,3 +100,18 @@ def test_failed_design_never_carries_a_number(tmp_path):
     back = pd.read_parquet(out).set_index("design_id")
     assert back.loc["a", "lost_motion_arcmin"] == 0.5
     assert pd.isna(back.loc["b", "lost_motion_arcmin"])
+
+
+def test_an_arrow_row_reads_back_as_the_pandas_row_it_replaces(tmp_path):
+    """A solve job writes its row as Arrow (no pandas in its process); the aggregation reads it
+    with pandas: the same values and dtypes as a row pandas wrote, a failed Φ missing (null, NaN),
+    not a number, and the units in the field metadata."""
+    row = {"design_id": "hd42-lhs-01", "d_mm": 31.0, "lost_motion_arcmin": float("nan"),
+           "status": "failed: contact did not converge", "iterations": 200}
+    arrow = write_parquet(arrow_row(row), tmp_path / "arrow.parquet", provenance={"git_commit": "x"})
+    panda = write_parquet(pd.DataFrame([row]), tmp_path / "pandas.parquet", provenance={"git_commit": "x"})
+    a, b = pd.read_parquet(arrow), pd.read_parquet(panda)
+    pd.testing.assert_frame_equal(a, b)
+    assert pq.read_table(arrow).column("lost_motion_arcmin").null_count == 1
+    assert pq.read_schema(arrow).field("d_mm").metadata == {b"unit": b"mm"}
+    assert read_parquet_meta(arrow)[0] == {"git_commit": "x"}

@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pandas as pd
 import pytest
 
+from hdwf.common.io import arrow_row, arrow_table, write_parquet
 from hdwf.drive.design import MeshSettings, geometry_of
 from hdwf.fe import solve_lost_motion
+from hdwf.stages.fe import aggregate_stage
 from hdwf.stages.fe_solve import DesignOutputs, refined_solve_stage, solve_stage
 from hdwf.validation.effects import model_changes
 
@@ -52,3 +55,25 @@ def test_study_stages_solve_the_switched_on_effects(tmp_path):
     refined = refined_solve_stage(designs, "d1", "hd42", MESH, 1, tmp_path / "refined.parquet", {},
                                   effects=EFFECTS)
     assert refined["lost_motion_arcmin"] == pytest.approx(row["lost_motion_arcmin"], abs=1e-9)
+
+
+def test_a_failed_designs_row_aggregates_without_a_number(tmp_path):
+    """Rows and curves as the solve jobs write them (Arrow, no pandas), one design failed: the study's
+    table keeps every Φ column a float, the failed design's Φ missing (never a number), its status
+    saying why."""
+    nan = float("nan")
+    rows, curves = [], []
+    for design_id, phi, status in (("d1", 0.5, "ok"), ("d2", nan, "failed: contact did not converge")):
+        row = {**DESIGN, "design_id": design_id, "phi_plus_arcmin": phi / 2 if phi == phi else nan,
+               "phi_minus_arcmin": phi / 2 if phi == phi else nan, "lost_motion_arcmin": phi, "status": status,
+               "iterations": 200}
+        rows.append(write_parquet(arrow_row(row), tmp_path / f"{design_id}.parquet", provenance={}))
+        curve = {"design_id": [design_id] * 2, "step": np.arange(2), "torque_Nm": np.array([0.0, 1.0]),
+                 "twist_arcmin": np.array([0.0, phi])}
+        curves.append(write_parquet(arrow_table(curve), tmp_path / f"{design_id}_curve.parquet", provenance={}))
+    aggregate_stage(rows, curves, tmp_path / "lost_motion.parquet", tmp_path / "curves.parquet", {}, {"unit": "hd42"})
+    table = pd.read_parquet(tmp_path / "lost_motion.parquet").set_index("design_id")
+    assert all(table[c].dtype == np.float64 for c in ("phi_plus_arcmin", "phi_minus_arcmin", "lost_motion_arcmin"))
+    assert table.loc["d1", "lost_motion_arcmin"] == 0.5 and np.isnan(table.loc["d2", "lost_motion_arcmin"])
+    assert table.loc["d2", "status"].startswith("failed")
+    assert pd.read_parquet(tmp_path / "curves.parquet")["twist_arcmin"].dtype == np.float64

@@ -77,7 +77,12 @@ def unit_of(column: str) -> str | None:
 
 def arrow_table(columns: Mapping[str, object]) -> pa.Table:
     """An Arrow table from ``{column: sequence}``, NaN stored as null as ``pandas`` stores it."""
-    return pa.table({name: pa.array(values, from_pandas=True) for name, values in columns.items()})
+    return pa.table({name: _arrow_column(values) for name, values in columns.items()})
+
+
+def _arrow_column(values) -> pa.Array:
+    typed = pa.array(values)    # typed before NaN becomes null: a failed row's NaN stays a double
+    return pa.array(values, type=typed.type, from_pandas=True) if pa.types.is_floating(typed.type) else typed
 
 
 def arrow_row(row: Mapping[str, object]) -> pa.Table:
