@@ -307,6 +307,18 @@ def test_ladder_is_held_against_the_bearing_rating():
     assert _bearing_sentence(lad.drop(columns=["specimens_checked"])) == ""
 
 
+def test_ladder_names_the_rungs_whose_solve_failed():
+    """A rung with a failed specimen has no error in the table (``ladder_table``); the text says which
+    rung and specimen, and says nothing when every rung solved or the ladder predates the column."""
+    import pandas as pd
+    from hdwf.report.validation_part import _failed_rungs_sentence
+    lad = pd.DataFrame({"rung": [0, 1], "model": ["baseline", "with preload"], "failed_specimens": ["", "paper-03"]})
+    said = _failed_rungs_sentence(lad)
+    assert "rung 1 (with preload) for paper-03" in said and "rung 0" not in said
+    assert _failed_rungs_sentence(lad.iloc[:1]) == ""
+    assert _failed_rungs_sentence(lad.drop(columns=["failed_specimens"])) == ""
+
+
 def test_ladder_rungs_give_the_values_they_were_solved_with():
     """A rung's values are read from the ladder's ``effects`` (the final calibration, not the
     rounds' table estimates), each with its effect's unit, to four significant figures and never
@@ -450,6 +462,24 @@ def test_the_ladder_figure_names_each_rungs_effect_and_shows_a_large_fall_on_a_l
     assert low < 0.19 and high > 8.96                                           # every rung and the noise in view
     for fig in drawn:
         plt.close(fig)
+
+
+def test_a_failed_rung_is_left_out_of_the_ladder_figure_not_labelled_nan(monkeypatch, tmp_path):
+    """A rung whose solve failed has no RMSE (``ladder_table``): the figure labels the two rungs that
+    have one and still puts the fall from 8.96 to 0.194 (46x) on a log axis."""
+    import matplotlib.pyplot as plt
+    import pandas as pd
+
+    from hdwf.report import figures
+
+    drawn = []
+    monkeypatch.setattr(figures, "_save", lambda fig, path: drawn.append(fig))
+    figures.ladder_figure(pd.DataFrame({"model": ["baseline", "with preload", "with preload, cup_torsion"],
+                                        "rmse_arcmin": [8.96, float("nan"), 0.194]}), None, "t", tmp_path / "a.png")
+    ax = drawn[0].axes[0]
+    assert [t.get_text() for t in ax.texts] == ["8.96", "0.194"]
+    assert ax.get_yscale() == "log"
+    plt.close(drawn[0])
 
 
 def test_the_summary_gathers_each_parts_headline_figure(named_inputs, tmp_path):

@@ -58,3 +58,18 @@ def test_a_table_without_pressures_checks_nothing():
     assert np.isnan(got["ball_pressure_max_MPa"]) and got["specimens_checked"] == 0
     failed = table.assign(ball_pressure_max_MPa=np.where(table["specimen_id"] == "s2", np.nan, 3000.0))
     assert bearing_check(failed, variant_key(PRELOAD))["specimens_checked"] == 1
+
+
+def test_a_rung_whose_solve_failed_for_a_specimen_has_no_error():
+    """s2's preloaded solve fails. Scored on s1 alone (error 0.1) over both observations, that rung
+    would read RMSE 0.0707 and beat one that solved both; it must have no error at all, and say
+    which specimen failed. The bare rung, solved for both, keeps its RMSE of 2."""
+    meas, table = _campaign()
+    failed = (table["specimen_id"] == "s2") & (table["variant"] == variant_key(PRELOAD))
+    table.loc[failed, "twist_arcmin"] = np.nan
+    table.loc[failed, "status"] = "failed: no contact pair"
+    lad = ladder_table(meas, table, ladder_variants({}, [("preload", {"interference_m": 0.2})]))
+    assert lad["rmse_arcmin"].iloc[0] == pytest.approx(2.0)
+    assert lad["solved"].tolist() == [True, False]
+    assert lad["failed_specimens"].tolist() == ["", "s2"]
+    assert lad.loc[1, ["rmse_arcmin", "bias_arcmin", "max_abs_arcmin", "delta_bic"]].isna().all()

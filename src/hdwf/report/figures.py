@@ -377,7 +377,7 @@ def ladder_figure(ladder: pd.DataFrame, noise_arcmin: float | None, title: str, 
     x = np.arange(len(ladder))
     rmse = ladder["rmse_arcmin"].to_numpy(float)
     ax.plot(x, rmse, "o-", color="tab:blue", label="RMSE (actual solves)")
-    for xi, r in zip(x, rmse):
+    for xi, r in zip(x[np.isfinite(rmse)], rmse[np.isfinite(rmse)]):   # a failed rung has no error
         ax.annotate(f"{r:.3g}", (xi, r), textcoords="offset points", xytext=(5, 5), fontsize=8)
     if noise_arcmin:
         ax.axhline(noise_arcmin, color="tab:gray", ls="--", label=f"noise {noise_arcmin:.3g} arcmin")

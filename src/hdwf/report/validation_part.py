@@ -304,6 +304,16 @@ def _runner_up(rnd: dict, best: dict, ties: list) -> str:
             "are strong, above 10 very strong).")
 
 
+def _failed_rungs_sentence(ladder: pd.DataFrame) -> str:
+    """The rungs whose solve failed for some specimen, and so have no error (``ladder_table``)."""
+    if "failed_specimens" not in ladder:
+        return ""
+    failed = [f"rung {r['rung']} ({lit(r['model'])}) for {lit(r['failed_specimens'])}"
+              for r in ladder.to_dict("records") if r["failed_specimens"]]
+    return (f"*No error is given where a rung's solve failed:* {'; '.join(failed)} (see their tables' status)."
+            if failed else "")
+
+
 def _bearing_sentence(ladder: pd.DataFrame) -> str:
     """The rungs held against the wave-generator bearing's static rating (ISO 76, 4200 MPa)."""
     if "specimens_checked" not in ladder or not ladder["specimens_checked"].gt(0).any():
@@ -358,6 +368,9 @@ def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2,
               "final calibrated values (after any recalibration on actual solves, so they and the RMSE can differ "
               "from the rounds' table estimates above). ΔBIC against the first rung."
               + (f" Stated noise: {fmt(noise, 4)} arcmin." if noise else ""))
+    failed = _failed_rungs_sentence(ladder)
+    if failed:
+        doc.text(failed)
     bearing = _bearing_sentence(ladder)
     if bearing:
         doc.text(bearing)

@@ -61,9 +61,12 @@ def ladder_table(meas: Measurements, table: pd.DataFrame, rungs: list[tuple[str,
     -------
     pandas.DataFrame
         ``rung``, ``model``, ``effects`` (JSON), ``n_params``, ``rmse_arcmin``, ``bias_arcmin``,
-        ``max_abs_arcmin``, ``delta_bic`` (against the first rung), ``solved``, and the bearing
+        ``max_abs_arcmin``, ``delta_bic`` (against the first rung), ``solved``,
+        ``failed_specimens`` (comma-separated; empty when every solve succeeded), and the bearing
         check of the rung's model (``bearing_check``): the largest ball pressure at the mount over
-        the specimens and how many exceed ISO 76's static rating.
+        the specimens and how many exceed ISO 76's static rating. A rung whose solve failed for
+        any specimen has no error figures (NaN): scored on the specimens left, it would look
+        better than a rung that solved them all.
     """
     obs = observation_frame(meas)
     D = obs["D"].to_numpy(float)
@@ -71,13 +74,15 @@ def ladder_table(meas: Measurements, table: pd.DataFrame, rungs: list[tuple[str,
     for k, (label, eff) in enumerate(rungs):
         S = predict(table, obs, variant_key(eff))
         n_par = sum(len(v) for v in eff.values())
-        rss = float(np.nansum((S - D) ** 2))
-        b = bic(rss, len(D), n_par)
+        solved = np.isfinite(S)
+        E = np.where(solved.all(), S - D, np.nan)
+        b = bic(float(np.sum(E ** 2)), len(D), n_par)
         b0 = b if b0 is None else b0
         rows.append({"rung": k, "model": label, "effects": json.dumps(eff, sort_keys=True),
-                     "n_params": n_par, "rmse_arcmin": float(np.sqrt(rss / len(D))),
-                     "bias_arcmin": float(np.nanmean(S - D)), "max_abs_arcmin": float(np.nanmax(np.abs(S - D))),
-                     "delta_bic": float(b - b0), "solved": bool(np.isfinite(S).all()),
+                     "n_params": n_par, "rmse_arcmin": float(np.sqrt(np.mean(E ** 2))),
+                     "bias_arcmin": float(np.mean(E)), "max_abs_arcmin": float(np.max(np.abs(E))),
+                     "delta_bic": float(b - b0), "solved": bool(solved.all()),
+                     "failed_specimens": ", ".join(sorted(set(obs["specimen_id"].to_numpy()[~solved]))),
                      **bearing_check(table, variant_key(eff))})
     return pd.DataFrame(rows)
 
