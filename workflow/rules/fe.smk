@@ -83,6 +83,7 @@ rule fe_refined_solve:
     threads: 1
     resources:
         mem_mb=4000,
+        runtime=45,  # a 1.25x mesh takes about 1.4x the default's solve
     benchmark:
         "results/benchmarks/{study}_{unit}_convergence_r{ref}_{design}.tsv"
     log:
@@ -121,6 +122,9 @@ rule fe_deformed:
         steps_per_ramp=FE["steps_per_ramp"],
         effects=FE["effects"],
     threads: 1
+    resources:
+        mem_mb=4000,
+        runtime=30,
     benchmark:
         "results/benchmarks/{study}_{unit}_deformed_{design}.tsv"
     log:

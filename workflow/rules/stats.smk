@@ -47,6 +47,9 @@ rule sobol:
         settings={k: v for k, v in config["sobol"].items() if k != "samplers"},
         samplers=config["sobol"]["samplers"],
     priority: 2
+    resources:
+        mem_mb=2000,
+        runtime=20,
     benchmark:
         "results/benchmarks/{study}_{unit}_sobol.tsv"
     log:

@@ -44,6 +44,7 @@ rule validation_diagnosis:
     priority: 2
     resources:
         mem_mb=8000,
+        runtime=120,  # some 160 re-solves: 3.6 min on this project's 2-core machine
     benchmark:
         "results/validation/{campaign}/benchmarks/diagnosis.tsv"
     log:
@@ -70,6 +71,7 @@ rule validation_ladder:
     priority: 2
     resources:
         mem_mb=4000,
+        runtime=60,
     benchmark:
         "results/validation/{campaign}/benchmarks/ladder.tsv"
     log:
