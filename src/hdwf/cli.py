@@ -20,7 +20,7 @@ from hdwf.stages.validation import campaign_plan, campaign_specimens
 from hdwf.study.paper import PAPER_TABLES, paper_measurements
 from hdwf.validation.detectability import plan_detectability
 from hdwf.validation.effects import parse_assignment, registry
-from hdwf.validation.jsonsafe import json_safe
+from hdwf.common.jsonsafe import json_safe
 from hdwf.validation.measurements import MeasurementError, load_measurements, schedule_problems
 from hdwf.validation.synthesis import design_ranges, format_ranges, parse_range, synth_designs, synthesize
 from hdwf.validation.variants import SolveSetup

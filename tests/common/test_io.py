@@ -10,7 +10,7 @@ import pytest
 from hdwf.stages.paper import paper_lost_motion_stage
 from hdwf.study.aggregate import write_lost_motion
 from hdwf.common.provenance import config_hash
-from hdwf.common.io import arrow_row, atomic_path, read_parquet_meta, write_parquet
+from hdwf.common.io import arrow_row, atomic_path, read_parquet_meta, write_json, write_parquet
 from hdwf.common.provenance import provenance
 
 from conftest import ROOT
@@ -115,3 +115,17 @@ def test_an_arrow_row_reads_back_as_the_pandas_row_it_replaces(tmp_path):
     assert pq.read_table(arrow).column("lost_motion_arcmin").null_count == 1
     assert pq.read_schema(arrow).field("d_mm").metadata == {b"unit": b"mm"}
     assert read_parquet_meta(arrow)[0] == {"git_commit": "x"}
+
+
+def test_json_artefacts_are_strict_json(tmp_path):
+    """A surrogate's leave-one-out Q² is -inf when a design has leverage 1; Python would write
+    ``-Infinity``, which no strict JSON reader takes. NaN and inf are written as null, arrays and
+    numpy scalars as plain numbers."""
+    import json
+
+    import numpy as np
+    path = write_json({"q2_loo": -np.inf, "r2": np.float64(0.98), "n": np.int64(27), "phi": np.array([1.5, np.nan])},
+                      tmp_path / "s.json")
+    text = path.read_text()
+    assert json.loads(text, parse_constant=lambda c: pytest.fail(f"non-JSON constant {c}")) == \
+        {"q2_loo": None, "r2": 0.98, "n": 27, "phi": [1.5, None]}

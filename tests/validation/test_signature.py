@@ -13,7 +13,7 @@ from hdwf.report.document import Document
 from hdwf.report.validation_part import signature_section
 from hdwf.validation.comparison import branches, comparison_points
 from hdwf.validation.diagnosis import Search, diagnose
-from hdwf.validation.jsonsafe import json_safe
+from hdwf.common.jsonsafe import json_safe
 from hdwf.validation.measurements import Measurements
 from hdwf.validation.signature import SIGNIFICANT_Z, residual_signature
 from hdwf.validation.variants import plan_variants, variant_key

@@ -13,7 +13,7 @@ from hdwf.validation.comparison import Candidate, bic, branches, comparison_poin
 from hdwf.validation.detectability import detectability
 from hdwf.validation.diagnosis import Search, _GreedySearch
 from hdwf.validation.effects import get
-from hdwf.validation.jsonsafe import json_safe
+from hdwf.common.jsonsafe import json_safe
 from hdwf.validation.variants import plan_variants, variant_key
 
 TORQUES = [0.0, 0.48, 0.96, 0.48, 0.0, -0.48, -0.96, -0.48, 0.0]

@@ -1,3 +1,3 @@
 """Plumbing every stage shares: atomic file writes and Parquet metadata (``io``), the provenance
 stamped on each artefact (``provenance``) and the errors that name a file, field and value
-(``errors``)."""
+(``errors``), and values as strict JSON takes them (``jsonsafe``)."""

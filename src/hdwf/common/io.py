@@ -20,6 +20,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from hdwf.common.errors import InputError
+from hdwf.common.jsonsafe import json_safe
 
 if TYPE_CHECKING:   # pandas is imported where a table is read: a solve job writes Arrow and never needs it
     import pandas as pd
@@ -126,17 +127,12 @@ def read_parquet_meta(path: str | Path) -> tuple[dict | None, dict | None]:
 
 
 def write_json(obj, path: str | Path) -> Path:
+    """Write ``obj`` atomically as strict JSON: NaN and inf as null (``jsonsafe``), which every JSON
+    reader takes, where Python's ``NaN`` / ``Infinity`` are not JSON."""
+    text = json.dumps(json_safe(obj), indent=2, sort_keys=False, allow_nan=False) + "\n"
     with atomic_path(path) as tmp:
-        tmp.write_text(json.dumps(obj, indent=2, sort_keys=False, default=_json_default) + "\n")
+        tmp.write_text(text)
     return Path(path)
-
-
-def _json_default(o):
-    if isinstance(o, np.generic):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
 
 
 def read_json(path: str | Path):

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 import pandas as pd
 
 from hdwf.common.io import read_json, write_json, write_parquet
-from hdwf.validation.jsonsafe import json_safe
+from hdwf.common.jsonsafe import json_safe
 from hdwf.validation.ladder import ladder_variants, solve_ladder
 from hdwf.validation.measurements import MeasurementError, load_measurements, schedule_problems
 from hdwf.validation.variants import SolveSetup, candidate_names, plan_variants, specimen_solver

@@ -16,8 +16,7 @@ One module per idea, in the order a campaign uses them:
   estimate, leave-one-specimen-out error;
 * ``detectability``: which candidates data at a given noise could show (``hdwf plan``);
 * ``diagnosis``: the greedy search and its typed result (``diagnosis.json``);
-* ``ladder``: the model's error rung by rung, from actual solves;
-* ``jsonsafe``: values as strict JSON takes them.
+* ``ladder``: the model's error rung by rung, from actual solves.
 
 Reading and writing the workflow's files is ``hdwf.stages.validation``'s job.
 """

@@ -1,5 +1,5 @@
-"""Values as strict JSON takes them: the diagnosis and the detectability plan hold NaN, inf and
-numpy scalars."""
+"""Values as strict JSON takes them: the diagnosis, the detectability plan and a surrogate's
+leave-one-out error can hold NaN, inf and numpy scalars."""
 
 from __future__ import annotations
 
@@ -20,12 +20,14 @@ def json_safe(obj):
     -------
     object
         The same structure with NaN and inf as None, numpy scalars as Python numbers, tuples
-        as lists and keys as strings.
+        and arrays as lists and keys as strings.
     """
     if isinstance(obj, dict):
         return {str(k): json_safe(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
         return [json_safe(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return json_safe(obj.tolist())
     if isinstance(obj, (np.floating, float)):
         return float(obj) if math.isfinite(obj) else None
     if isinstance(obj, np.integer):
