@@ -77,3 +77,22 @@ def test_a_failed_designs_row_aggregates_without_a_number(tmp_path):
     assert table.loc["d1", "lost_motion_arcmin"] == 0.5 and np.isnan(table.loc["d2", "lost_motion_arcmin"])
     assert table.loc["d2", "status"].startswith("failed")
     assert pd.read_parquet(tmp_path / "curves.parquet")["twist_arcmin"].dtype == np.float64
+
+
+def test_a_mesh_that_fails_leaves_no_file_behind(tmp_path, monkeypatch):
+    """gmsh writes the mesh under a temporary ``.msh`` name (it picks the format from the extension);
+    a mesh that fails after gmsh wrote must leave neither that file nor the ``.tmp`` beside the
+    results, and no mesh, row or curve."""
+    designs = tmp_path / "designs.parquet"
+    pd.DataFrame([DESIGN]).to_parquet(designs)
+
+    def fails_after_writing(self, geom, path=None):
+        with open(path, "w") as f:
+            f.write("$MeshFormat")
+        raise RuntimeError("gmsh: no mesh")
+
+    monkeypatch.setattr(MeshSettings, "mesh", fails_after_writing)
+    out = DesignOutputs(tmp_path / "mesh" / "d1.msh", tmp_path / "row.parquet", tmp_path / "curve.parquet")
+    with pytest.raises(RuntimeError, match="no mesh"):
+        solve_stage(designs, "d1", "hd42", MESH, 1, out, {})
+    assert sorted(p.name for p in tmp_path.rglob("*") if p.is_file()) == ["designs.parquet"]

@@ -32,8 +32,11 @@ def _mesh_to(geom, settings: Mapping, out_msh) -> DriveMesh:
     with atomic_path(out_msh) as tmp_msh:
         # gmsh picks the format from the extension, so the temporary name keeps ".msh".
         tmp_named = tmp_msh.with_suffix(".msh")
-        mesh = MeshSettings.from_mapping(settings).mesh(geom, path=str(tmp_named))
-        tmp_named.replace(tmp_msh)
+        try:
+            mesh = MeshSettings.from_mapping(settings).mesh(geom, path=str(tmp_named))
+            tmp_named.replace(tmp_msh)
+        finally:    # a mesh that failed leaves no hidden file beside the results
+            tmp_named.unlink(missing_ok=True)
     return mesh
 
 
