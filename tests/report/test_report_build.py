@@ -45,6 +45,20 @@ def named_inputs(tmp_path_factory):
     return inputs, owners
 
 
+def test_every_study_figure_carries_the_provenance_of_its_stage(named_inputs):
+    """A PNG is an artefact too: the correlation, surrogate and Sobol' figures hold the stage's
+    provenance (config hash, commit, versions) in their ``hdwf.provenance`` text chunk."""
+    import json
+
+    from PIL import Image
+
+    from hdwf.report.figures import PROVENANCE_TEXT_KEY
+    inputs, _ = named_inputs
+    for kind in ("correlation_png", "surrogate_png", "sobol_png"):
+        with Image.open(inputs[kind][0]) as png:
+            assert json.loads(png.text[PROVENANCE_TEXT_KEY]) == PROVENANCE, kind
+
+
 def test_inputs_are_regrouped_by_owner():
     inputs = {"sobol": ["a/s", "b/s"], "diagnosis": ["v/d"]}
     owners = {"sobol": [["paper", "hd42"], ["fe", "hd120"]], "diagnosis": [["demo"]]}

@@ -182,8 +182,13 @@ def test_validation_campaign_chain(tmp_path):
                                      "mesh": {"elements_over_height": 5, "elements_over_thickness": 3}}}
     (ws / "config.yaml").write_text(yaml.safe_dump(config))
     target = "results/validation/tiny/ladder.parquet"
-    run = subprocess.run([SNAKEMAKE, "--cores", "2", target], cwd=ws, capture_output=True, text=True, timeout=900)
+    figure = "results/validation/tiny/ladder.png"
+    run = subprocess.run([SNAKEMAKE, "--cores", "2", target, figure], cwd=ws, capture_output=True, text=True,
+                         timeout=900)
     assert run.returncode == 0, run.stderr[-3000:]
+    from PIL import Image
+    with Image.open(ws / figure) as png:    # the figure records what made it, as the tables do
+        assert json.loads(png.text["hdwf.provenance"])["config_hash"] == config_hash(load_config(ws / "config.yaml"))
     for sid in keep:   # one job per specimen, each with its table
         assert (ws / f"results/validation/tiny/tables/{sid}.parquet").exists()
     diag = json.loads((ws / "results/validation/tiny/diagnosis.json").read_text())

@@ -3,6 +3,9 @@ deformed mesh) and of the validation campaigns, each written atomically as a PNG
 
 from __future__ import annotations
 
+import json
+from contextlib import contextmanager
+from contextvars import ContextVar
 
 import matplotlib
 import matplotlib.pyplot as plt
@@ -20,11 +23,27 @@ from hdwf.study.knee import HingeFit
 matplotlib.use("Agg")
 
 _PNG_META = {"Software": None}  # no version string in the file: same data, same bytes
+PROVENANCE_TEXT_KEY = "hdwf.provenance"
+_provenance: ContextVar[str | None] = ContextVar("figure_provenance", default=None)
+
+
+@contextmanager
+def stamped(provenance: dict | None):
+    """Figures saved inside the block carry ``provenance`` (JSON) in the PNG text chunk
+    ``hdwf.provenance``, as a Parquet artefact carries it in its metadata."""
+    token = _provenance.set(json.dumps(provenance, sort_keys=True) if provenance else None)
+    try:
+        yield
+    finally:
+        _provenance.reset(token)
 
 
 def _save(fig, path):
+    meta = dict(_PNG_META)
+    if _provenance.get() is not None:
+        meta[PROVENANCE_TEXT_KEY] = _provenance.get()
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=150, format="png", metadata=_PNG_META, bbox_inches="tight")
+        fig.savefig(tmp, dpi=150, format="png", metadata=meta, bbox_inches="tight")
     plt.close(fig)
 
 

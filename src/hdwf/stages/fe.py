@@ -5,6 +5,7 @@ each) are ``hdwf.stages.fe_solve``.
 
 from __future__ import annotations
 
+import json
 from typing import Mapping
 
 import numpy as np
@@ -66,12 +67,14 @@ def deformed_stage(designs_path, design_id: str, unit: str, settings: Mapping, s
     if res.status != "ok":
         raise RuntimeError(f"{design_id}: solve failed ({res.reason}); no picture of a failed state")
     arrays = {f"{state}:{body}": u for state, per_body in res.fields.items() for body, u in per_body.items()}
+    arrays["provenance"] = np.array(json.dumps(provenance, sort_keys=True))   # a string: loads without pickle
     with atomic_path(out_npz) as tmp:
         with open(tmp, "wb") as fh:
             np.savez_compressed(fh, **arrays)
     pitch = 2 * np.pi * geom.r_fs_pitch / geom.z_fs
-    from hdwf.report.figures import deformed_figure   # matplotlib only here: the per-design jobs start faster
-    deformed_figure(mesh, res.fields, f"{unit} {design_id} at +4 % T_N (Φ = {res.lost_motion_arcmin:.3f} arcmin), "
-                    "true scale", out_png, half_width_mm=2.5 * pitch,
-                    xlim=(geom.r_fs_bore - 2 * geom.module, geom.r_cs_root + 3 * geom.module))
+    from hdwf.report.figures import deformed_figure, stamped   # matplotlib only here: the per-design jobs start faster
+    with stamped(provenance):
+        deformed_figure(mesh, res.fields, f"{unit} {design_id} at +4 % T_N (Φ = {res.lost_motion_arcmin:.3f} arcmin), "
+                        "true scale", out_png, half_width_mm=2.5 * pitch,
+                        xlim=(geom.r_fs_bore - 2 * geom.module, geom.r_cs_root + 3 * geom.module))
     return {"design_id": design_id, "lost_motion_arcmin": res.lost_motion_arcmin}

@@ -9,7 +9,7 @@ import pandas as pd
 
 from hdwf import PARAMETER_COLUMNS, PARAMETERS
 from hdwf.common.io import read_json, write_json, write_parquet
-from hdwf.report.figures import correlation_figure, sobol_convergence_figure, surrogate_figure
+from hdwf.report.figures import correlation_figure, sobol_convergence_figure, stamped, surrogate_figure
 from hdwf.study.sobol import convergence, exact_indices
 from hdwf.study.stats import correlation
 from hdwf.study.surrogate import QuadraticSurrogate, fit_quadratic, rebound
@@ -20,7 +20,8 @@ def correlation_stage(lost_motion_path, out_parquet, out_png, title: str, proven
     designs = pd.read_parquet(lost_motion_path)
     table, summary = correlation(designs)
     write_parquet(table, out_parquet, provenance=provenance, meta={"ols": asdict(summary)})
-    correlation_figure(designs, table, title, out_png)
+    with stamped(provenance):
+        correlation_figure(designs, table, title, out_png)
     return table
 
 
@@ -43,7 +44,8 @@ def surrogate_stage(lost_motion_path, out_json, out_png, bounds_source: str, tab
     model = fit_quadratic(X, y, lower, upper, bounds_source)
     model.extra["n_failed_designs"] = int(len(designs) - len(ok))
     write_json({**model.to_dict(), "provenance": provenance}, out_json)
-    surrogate_figure(ok, model.predict(X), title, out_png)
+    with stamped(provenance):
+        surrogate_figure(ok, model.predict(X), title, out_png)
     return model
 
 
@@ -69,5 +71,6 @@ def sobol_stage(surrogate_json, out_parquet, out_png, samplers, settings: dict, 
     write_parquet(table, out_parquet, provenance=provenance,
                   meta={"convergence": status, "exact_other_bounds": other, "settings": settings, "bounds_source": model.bounds_source,
                         "lower": model.lower, "upper": model.upper})
-    sobol_convergence_figure(table, title, out_png)
+    with stamped(provenance):
+        sobol_convergence_figure(table, title, out_png)
     return table

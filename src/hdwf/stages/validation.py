@@ -218,7 +218,8 @@ def ladder_stage(setup: SolveSetup, inputs: CampaignInputs, diagnosis_json, out,
     return ladder
 
 
-def figures_stage(diagnosis_json, points, ladder, out_measured, out_residuals, out_ladder) -> None:
+def figures_stage(diagnosis_json, points, ladder, out_measured, out_residuals, out_ladder,
+                  provenance: dict | None = None) -> None:
     """Measured against predicted, the residuals and the ladder of a campaign (PNG).
 
     Parameters
@@ -227,11 +228,14 @@ def figures_stage(diagnosis_json, points, ladder, out_measured, out_residuals, o
         The campaign's ``diagnosis.json``, comparison points and ladder.
     out_measured, out_residuals, out_ladder : path
         The three figures.
+    provenance : dict, optional
+        Stamped in each PNG (``hdwf.report.figures.stamped``).
     """
     diag = read_json(diagnosis_json)
     pts = pd.read_parquet(points)
     name = f"{diag['campaign']} ({diag['unit'].upper()})"
-    from hdwf.report.figures import ladder_figure, measured_vs_predicted_figure, residual_figure
-    measured_vs_predicted_figure(pts, f"{name}: measured against predicted", out_measured)
-    residual_figure(pts, f"{name}: residuals", out_residuals)
-    ladder_figure(pd.read_parquet(ladder), diag.get("noise_arcmin"), f"{name}: the error ladder", out_ladder)
+    from hdwf.report.figures import ladder_figure, measured_vs_predicted_figure, residual_figure, stamped
+    with stamped(provenance):
+        measured_vs_predicted_figure(pts, f"{name}: measured against predicted", out_measured)
+        residual_figure(pts, f"{name}: residuals", out_residuals)
+        ladder_figure(pd.read_parquet(ladder), diag.get("noise_arcmin"), f"{name}: the error ladder", out_ladder)
