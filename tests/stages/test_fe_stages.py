@@ -12,7 +12,7 @@ from hdwf.common.io import arrow_row, arrow_table, write_parquet
 from hdwf.drive.design import MeshSettings, geometry_of
 from hdwf.fe import solve_lost_motion
 from hdwf.stages.fe import aggregate_stage
-from hdwf.stages.fe_solve import DesignOutputs, refined_solve_stage, solve_stage
+from hdwf.stages.fe_solve import DesignJob, DesignOutputs, refined_solve_stage, solve_stage
 from hdwf.validation.effects import model_changes
 
 # HD 42, Table 3's nominal bearing, r_FS = r_CS = 5 µm
@@ -30,7 +30,7 @@ def test_study_stages_solve_the_switched_on_effects(tmp_path):
     designs = tmp_path / "designs.parquet"
     pd.DataFrame([DESIGN]).to_parquet(designs)
     out = DesignOutputs(tmp_path / "d1.msh", tmp_path / "row.parquet", tmp_path / "curve.parquet")
-    row = solve_stage(designs, "d1", "hd42", MESH, 1, out, {}, effects=EFFECTS)
+    row = solve_stage(DesignJob(designs, "d1", "hd42", MESH, 1, EFFECTS), out, {})
     assert row["status"] == "ok", row["status"]
     assert out.msh.stat().st_size > 0 and out.curve.exists()
 
@@ -52,8 +52,7 @@ def test_study_stages_solve_the_switched_on_effects(tmp_path):
     # 0.1 m = 18 µm exceeds the 10 µm of rigid clearance per flank: no play left, Φ is elastic only
     assert alone.lost_motion_arcmin < 0.34  # a tenth of the bare section's 3.4 arcmin
 
-    refined = refined_solve_stage(designs, "d1", "hd42", MESH, 1, tmp_path / "refined.parquet", {},
-                                  effects=EFFECTS)
+    refined = refined_solve_stage(DesignJob(designs, "d1", "hd42", MESH, 1, EFFECTS), tmp_path / "refined.parquet", {})
     assert refined["lost_motion_arcmin"] == pytest.approx(row["lost_motion_arcmin"], abs=1e-9)
 
 
@@ -94,5 +93,5 @@ def test_a_mesh_that_fails_leaves_no_file_behind(tmp_path, monkeypatch):
     monkeypatch.setattr(MeshSettings, "mesh", fails_after_writing)
     out = DesignOutputs(tmp_path / "mesh" / "d1.msh", tmp_path / "row.parquet", tmp_path / "curve.parquet")
     with pytest.raises(RuntimeError, match="no mesh"):
-        solve_stage(designs, "d1", "hd42", MESH, 1, out, {})
+        solve_stage(DesignJob(designs, "d1", "hd42", MESH, 1), out, {})
     assert sorted(p.name for p in tmp_path.rglob("*") if p.is_file()) == ["designs.parquet"]

@@ -6,18 +6,16 @@ each) are ``hdwf.stages.fe_solve``.
 from __future__ import annotations
 
 import json
-from typing import Mapping
 
 import numpy as np
 import pandas as pd
 
 from hdwf import PARAMETER_COLUMNS
 from hdwf.common.io import atomic_path, read_parquet_meta, write_parquet
-from hdwf.drive.design import MeshSettings
 from hdwf.drive.geometry import nominal_geometry
 from hdwf.fe import solve_lost_motion
 from hdwf.fe.solver import TOL_GAP
-from hdwf.stages.fe_solve import design_model
+from hdwf.stages.fe_solve import DesignJob
 from hdwf.study.aggregate import write_lost_motion
 from hdwf.study.convergence import convergence_table, twist_resolution_arcmin
 from hdwf.study.paper import load_fea_designs
@@ -58,12 +56,12 @@ def convergence_stage(default_lost_motion, other_rows, default_refinement: float
     return table
 
 
-def deformed_stage(designs_path, design_id: str, unit: str, settings: Mapping, steps_per_ramp: int, out_png,
-                   out_npz, provenance: dict, effects: Mapping | None = None) -> dict:
+def deformed_stage(job: DesignJob, out_png, out_npz, provenance: dict) -> dict:
     """Solve one design keeping the displacement fields; picture of the mesh near the major axis."""
-    _, changes, geom = design_model(designs_path, design_id, unit, effects)
-    mesh = MeshSettings.from_mapping(settings).mesh(geom)
-    res = solve_lost_motion(geom, mesh, steps_per_ramp=steps_per_ramp, keep_fields=True, changes=changes)
+    _, changes, geom = job.model()
+    design_id, unit = job.design_id, job.unit
+    mesh = job.mesh(geom)
+    res = solve_lost_motion(geom, mesh, steps_per_ramp=job.steps_per_ramp, keep_fields=True, changes=changes)
     if res.status != "ok":
         raise RuntimeError(f"{design_id}: solve failed ({res.reason}); no picture of a failed state")
     arrays = {f"{state}:{body}": u for state, per_body in res.fields.items() for body, u in per_body.items()}

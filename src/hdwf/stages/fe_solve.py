@@ -19,21 +19,36 @@ from hdwf.study.fe_design import solve_design
 from hdwf.validation.effects import model_changes
 
 
-def design_model(designs_path, design_id: str, unit: str, effects: Mapping | None):
-    """One design's parameters, the study's switched-on changes (``fe.effects``) and the geometry
-    they shape (the preload thickens the teeth)."""
-    params = design_parameters(designs_path, design_id)
-    changes = model_changes(effects)
-    return params, changes, geometry_of(unit, params, **changes.geometry_part())
+@dataclass(frozen=True)
+class DesignJob:
+    """One design of a study to mesh and solve: where its parameters are, the study's mesh and load
+    steps, and the effects switched on in the study's model (``fe.effects``)."""
+    designs_path: str | Path
+    design_id: str
+    unit: str
+    settings: Mapping
+    steps_per_ramp: int
+    effects: Mapping | None = None
+
+    def model(self):
+        """The design's parameters, the switched-on changes and the geometry they shape (the preload
+        thickens the teeth)."""
+        params = design_parameters(self.designs_path, self.design_id)
+        changes = model_changes(self.effects)
+        return params, changes, geometry_of(self.unit, params, **changes.geometry_part())
+
+    def mesh(self, geom, path: str | None = None) -> DriveMesh:
+        """The design's mesh at the job's settings (gmsh's ``.msh`` written to ``path`` if given)."""
+        return MeshSettings.from_mapping(self.settings).mesh(geom, path=path)
 
 
-def _mesh_to(geom, settings: Mapping, out_msh) -> DriveMesh:
+def _mesh_to(job: DesignJob, geom, out_msh) -> DriveMesh:
     """Mesh a design's geometry, writing gmsh's ``.msh`` for review; returns the mesh."""
     with atomic_path(out_msh) as tmp_msh:
         # gmsh picks the format from the extension, so the temporary name keeps ".msh".
         tmp_named = tmp_msh.with_suffix(".msh")
         try:
-            mesh = MeshSettings.from_mapping(settings).mesh(geom, path=str(tmp_named))
+            mesh = job.mesh(geom, path=str(tmp_named))
             tmp_named.replace(tmp_msh)
         finally:    # a mesh that failed leaves no hidden file beside the results
             tmp_named.unlink(missing_ok=True)
@@ -48,28 +63,25 @@ class DesignOutputs:
     curve: str | Path
 
 
-def solve_stage(designs_path, design_id: str, unit: str, settings: Mapping, steps_per_ramp: int,
-                out: DesignOutputs, provenance: dict, effects: Mapping | None = None) -> dict:
+def solve_stage(job: DesignJob, out: DesignOutputs, provenance: dict) -> dict:
     """Mesh one design and solve it into its row and torque–twist curve (Parquet each), with the
-    study's switched-on ``effects`` (``{name: {parameter: value}}``).  One job does both: the mesh
-    takes a second or two, less than a job of its own spends starting and passing it on."""
-    params, changes, geom = design_model(designs_path, design_id, unit, effects)   # the preload reshapes the outline
+    study's switched-on effects.  One job does both: the mesh takes a second or two, less than a
+    job of its own spends starting and passing it on."""
+    params, changes, geom = job.model()   # the preload reshapes the outline
     t0 = time.perf_counter()
-    mesh = _mesh_to(geom, settings, out.msh)
+    mesh = _mesh_to(job, geom, out.msh)
     mesh_s = time.perf_counter() - t0
-    row, curve = solve_design(unit, params, mesh, steps_per_ramp, design_id, changes=changes)
+    row, curve = solve_design(job.unit, params, mesh, job.steps_per_ramp, job.design_id, changes=changes)
     row["mesh_s"] = mesh_s
-    write_parquet(arrow_row(row), out.row, provenance=provenance, meta={"unit": unit})
-    write_parquet(curve, out.curve, provenance=provenance, meta={"unit": unit})
+    write_parquet(arrow_row(row), out.row, provenance=provenance, meta={"unit": job.unit})
+    write_parquet(curve, out.curve, provenance=provenance, meta={"unit": job.unit})
     return row
 
 
-def refined_solve_stage(designs_path, design_id: str, unit: str, settings: Mapping, steps_per_ramp: int, out,
-                        provenance: dict, effects: Mapping | None = None) -> dict:
+def refined_solve_stage(job: DesignJob, out, provenance: dict) -> dict:
     """Mesh and solve one design at another refinement (mesh-convergence runs); one row out."""
-    params, changes, geom = design_model(designs_path, design_id, unit, effects)
-    row, _ = solve_design(unit, params, MeshSettings.from_mapping(settings).mesh(geom), steps_per_ramp, design_id,
-                          changes=changes)
-    row["refinement"] = float(settings["refinement"])
-    write_parquet(arrow_row(row), out, provenance=provenance, meta={"unit": unit})
+    params, changes, geom = job.model()
+    row, _ = solve_design(job.unit, params, job.mesh(geom), job.steps_per_ramp, job.design_id, changes=changes)
+    row["refinement"] = float(job.settings["refinement"])
+    write_parquet(arrow_row(row), out, provenance=provenance, meta={"unit": job.unit})
     return row
