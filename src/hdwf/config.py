@@ -76,7 +76,8 @@ def blame(sources: list[str | Path], field: str, value=None) -> str:
     """The last of ``sources`` (merged in order) whose YAML sets the dotted key ``field``.
 
     If that file sets it to another value than the offending ``value``, ``--config`` on the
-    command line overrode it.
+    command line overrode it. A bad key name (an unknown effect, a campaign name with a space) is
+    reported as the mapping's field with the key as its value: the file that holds that key set it.
     """
     for path in reversed(sources):
         try:
@@ -91,7 +92,8 @@ def blame(sources: list[str | Path], field: str, value=None) -> str:
             else:
                 break
         else:
-            return str(path) if value is None or node == value else "--config (command line)"
+            names_the_key = isinstance(node, dict) and isinstance(value, str) and value in node
+            return str(path) if value is None or node == value or names_the_key else "--config (command line)"
     return "--config (command line)"
 
 

@@ -78,6 +78,22 @@ def test_a_problem_is_blamed_on_the_config_file_that_sets_the_key(tmp_path):
     assert exc.value.file == "--config (command line)"
 
 
+def test_a_bad_key_name_is_blamed_on_the_config_file_that_holds_it(tmp_path):
+    """An unknown effect name in an overlay is reported as field 'fe.effects' with the key as its
+    value: the overlay, which holds that key, is named, not a --config that was never given."""
+    overlay = tmp_path / "overlay.yaml"
+    overlay.write_text("fe:\n  effects:\n    prelaod: {interference_m: 0.3}\n")
+    config = yaml.safe_load((ROOT / "config.yaml").read_text())
+    config["fe"]["effects"] = {"prelaod": {"interference_m": 0.3}}
+    with pytest.raises(ConfigError) as exc:
+        validate_config(config, SCHEMA, [ROOT / "config.yaml", overlay])
+    assert exc.value.file == str(overlay) and exc.value.field == "fe.effects" and exc.value.value == "prelaod"
+    config["fe"]["effects"] = {"prelaod2": {"interference_m": 0.3}}   # in no file: from --config
+    with pytest.raises(ConfigError) as exc:
+        validate_config(config, SCHEMA, [ROOT / "config.yaml", overlay])
+    assert exc.value.file == "--config (command line)"
+
+
 def _copy_tables(tmp_path):
     dst = tmp_path / "paper"
     shutil.copytree(ROOT / "data" / "paper", dst)
