@@ -333,6 +333,25 @@ def test_ladder_names_the_rungs_whose_solve_failed():
     assert _failed_rungs_sentence(lad.drop(columns=["failed_specimens"])) == ""
 
 
+def test_the_one_sentence_verdict_gives_the_ladders_re_solved_error_beside_the_table_estimate():
+    """The diagnosis's sentence quotes the final RMSE its calibration tables give (0.2537 on paper_hd42);
+    the ladder re-solves it (0.1986). The report says both, each for what it is; a campaign that found
+    nothing adds no re-solved figure."""
+    from hdwf.report.validation_part import signature_section
+    sig = {"terms": [], "noise": {"stated_median_arcmin": None, "estimate_arcmin": 0.2166, "flag": False,
+                                  "estimate_from": "scatter", "note": ""}, "significant_z": 3.0,
+           "text": "preload, then fs_cup_torsion explained it (RMSE 9.119 → 0.2537 arcmin on the calibration tables)"}
+    diag = {"signature": sig, "verdict": {"found_in_order": ["preload", "fs_cup_torsion"]}}
+    doc = Document("t", "s", PROVENANCE)
+    signature_section(doc, diag, 0.198643)
+    said = doc.blocks[-1]["text"]
+    assert "0.2537 arcmin on the calibration tables" in said
+    assert said.endswith("the last rung of the ladder below has RMSE 0.1986 arcmin.")
+    doc = Document("t", "s", PROVENANCE)
+    signature_section(doc, {**diag, "verdict": {"found_in_order": []}}, 0.198643)
+    assert "ladder" not in doc.blocks[-1]["text"]
+
+
 def test_ladder_rungs_give_the_values_they_were_solved_with():
     """A rung's values are read from the ladder's ``effects`` (the final calibration, not the
     rounds' table estimates), each with its effect's unit, to four significant figures and never

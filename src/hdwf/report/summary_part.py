@@ -85,7 +85,7 @@ def _campaigns(report: ReportInputs) -> list[Finding]:
         found.append(Finding(f"`{campaign.name}` ({UNIT_NAMES[diag['unit']]}): RMSE, bare model to the last rung; "
                              f"found {', '.join(lit(n) for n in named) if named else 'nothing'}", value,
                              f"stated noise {fmt(noise, 3)} arcmin" if noise else
-                             f"no noise stated (at most {fmt(estimate, 3)} arcmin, from the data)" if estimate else "–",
+                             f"no noise stated (at most {fmt(estimate, 3)} arcmin: the final model's residual)" if estimate else "–",
                              f"Part III, Campaign '{lit(campaign.name)}'"))
     return found
 

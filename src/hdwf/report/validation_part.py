@@ -191,7 +191,7 @@ def _where_it_fails(doc: Document, diag: dict, campaign: CampaignArtefacts, leve
     doc.figure(campaign.measured_png, "Measured against predicted: the campaign's model and the model with the found "
                "effects switched on (calibrated values; table interpolation).")
     along = " and along the test" if diag["form"] == "curve" else ""
-    doc.figure(campaign.residuals_png, f"Residuals D − S against each input (specimen means){along}.")
+    doc.figure(campaign.residuals_png, f"Residuals D − S (measured minus model, the opposite sign of E) against each input (specimen means){along}.")
 
 
 _TERM_LABELS = {"bias": "level bias", "slope": "slope on torque (compliance)",
@@ -218,7 +218,7 @@ def _signature_rows(sig: dict) -> list[list[str]]:
     return rows
 
 
-def signature_section(doc: Document, diag: dict) -> None:
+def signature_section(doc: Document, diag: dict, solved_final_rmse_arcmin: float | None = None) -> None:
     """What the campaign model's residual looks like (``diagnosis.json``: signature): a table of its
     terms and the verdict in one sentence. Nothing is added when the diagnosis has no signature.
 
@@ -228,19 +228,25 @@ def signature_section(doc: Document, diag: dict) -> None:
         The document to add to.
     diag
         The campaign's ``diagnosis.json``.
+    solved_final_rmse_arcmin
+        The ladder's last rung (actual solves), said beside the sentence's table estimate.
     """
     sig = diag.get("signature")
     if not sig:
         return
     doc.table(["residual signature", "value", "uncertainty (1 se)", "significant?"], _signature_rows(sig),
-              f"Residual signature: the campaign model's residual D − S (measured minus model) split into terms; "
+              f"Residual signature: the campaign model's residual D − S (measured minus model: the opposite sign "
+              f"of the comparison error E = S − D above) split into terms; "
               f"significant beyond {fmt(sig['significant_z'], 1)} standard errors. Trends: the per-specimen mean "
               "residual against each input (in arcmin across the specimens' range). Noise from the data: "
               f"{lit(sig['noise']['estimate_from'])}.")
     if sig["noise"]["flag"]:
         doc.text(f"Caution: {lit(sig['noise']['note'])}.")
     if sig.get("text"):
-        doc.text(f"In one sentence: {lit(sig['text'])}.")
+        solved = ("" if solved_final_rmse_arcmin is None or not diag.get("verdict", {}).get("found_in_order") else
+                  f" Re-solved with the FE model, the last rung of the ladder below has RMSE "
+                  f"{fmt(solved_final_rmse_arcmin, 4)} arcmin.")
+        doc.text(f"In one sentence: {lit(sig['text'])}.{solved}")
 
 
 def _round_table(doc: Document, rnd: dict) -> None:
@@ -352,7 +358,7 @@ def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2,
     doc.heading(f"Campaign '{campaign.name}' ({UNIT_NAMES[diag['unit']]})", level)
     _campaign_intro(doc, diag, study_mesh)
     _where_it_fails(doc, diag, campaign, level + 1)
-    signature_section(doc, diag)
+    signature_section(doc, diag, float(ladder["rmse_arcmin"].iloc[-1]))
     doc.heading("Which effect is missing", level + 1)
     for rnd in diag["rounds"]:
         _round_table(doc, rnd)

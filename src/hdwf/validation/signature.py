@@ -371,7 +371,7 @@ def describe(sig: ResidualSignature, found: list[str] | None = None, final_rmse_
     found : list of str, optional
         The effects the diagnosis found, in order.
     final_rmse_arcmin : float, optional
-        The RMSE with them switched on.
+        The RMSE with them switched on, as the calibration tables give it (the ladder re-solves it).
     closest : Ranked, optional
         The best-ranked candidate of round 1, when none was found.
     closest_at_bound : bool
@@ -394,7 +394,8 @@ def describe(sig: ResidualSignature, found: list[str] | None = None, final_rmse_
     parts.append(f"the residual's clearest component is {_dominant_phrase(sig, dom)}" if dom else
                  f"no component of the residual stands out from the noise (none beyond {SIGNIFICANT_Z:g} se)")
     if found:
-        end = f" (RMSE {sig.rmse_arcmin:.4g} → {final_rmse_arcmin:.4g} arcmin)" if final_rmse_arcmin is not None else ""
+        end = (f" (RMSE {sig.rmse_arcmin:.4g} → {final_rmse_arcmin:.4g} arcmin on the calibration tables)"
+               if final_rmse_arcmin is not None else "")
         parts.append(f"{', then '.join(found)} explained it{end}")
     elif closest is not None:
         where = " at its bound" if closest_at_bound else ""
