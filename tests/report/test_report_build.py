@@ -581,3 +581,29 @@ def test_a_campaign_on_a_coarser_mesh_than_the_studies_says_what_that_costs():
         assert "coarser" not in doc.blocks[-1]["text"]
     _campaign_intro(doc, diag, MeshSettings(refinement=0.5))      # the studies at 5 × 3 themselves
     assert "coarser" not in doc.blocks[-1]["text"]
+
+
+def test_the_deformed_picture_colours_the_stress_the_torque_adds(monkeypatch):
+    """FS and CS given a uniaxial field of 100 MPa at +T and none at the mount: every FS and CS triangle in
+    the window reads 100 MPa (a displacement colour would grow with x instead), the rings stay grey."""
+    import numpy as np
+    from matplotlib.collections import PolyCollection
+
+    from hdwf.drive.geometry import drive_geometry
+    from hdwf.drive.mesh import build_mesh
+    from hdwf.fe.bodies import Material
+    from hdwf.report import figures
+
+    g = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.005, 0.005)
+    mesh = build_mesh(g, 4, 3, 1.0, symmetry="half")
+    E, nu = 210_000.0, 0.3
+    plus = {name: np.vstack([100.0 / E * b.mesh.p[0], -nu * 100.0 / E * b.mesh.p[1]]) for name, b in mesh.bodies.items()}
+    wg = {name: np.zeros_like(u) for name, u in plus.items()}
+    drawn = []
+    monkeypatch.setattr(figures, "_save", lambda fig, path: drawn.append(fig))
+    figures.deformed_figure(mesh, {"plus": plus, "wg": wg}, Material(E, nu), "t", "x.png", half_width_mm=1.0,
+                            xlim=(g.r_fs_bore - 0.5, g.r_cs_root + 0.5))
+    coloured = [c for c in drawn[0].axes[0].collections if isinstance(c, PolyCollection) and c.get_array() is not None]
+    assert len(coloured) == 1 and coloured[0].get_array().size > 100
+    assert np.asarray(coloured[0].get_array()) == pytest.approx(100.0, rel=1e-9)
+    assert drawn[0].axes[1].get_ylabel() == "von Mises stress added by the test torque (MPa)"

@@ -66,7 +66,7 @@ def fe_model_section(doc: Document, assumptions: tuple[dict, ...], pictures: dic
               "Every value the paper does not give, with its source (`hdwf.drive.geometry`).")
     for label, path in pictures.items():
         doc.figure(path, f"{label}: the FS (left) and CS (right) teeth at the major axis at +4 % $T_N$, true scale; "
-                   "colour: deformation added by the test torque with each body's rotation removed. The white "
+                   "colour: the von Mises stress the test torque adds, where the load goes. The white "
                    "gaps are the clearance that $r_\"FS\"$ and $r_\"CS\"$ open.", width="75%")
 
 
@@ -172,7 +172,9 @@ def _solve_summary(name: str, lm: pd.DataFrame) -> str:
     return (f"{name}: {len(lm) - len(failed)} of {len(lm)} designs solved"
             + (f"; failed: {lit(', '.join(failed.design_id))} ({lit(failed.iloc[0].status)})" if len(failed) else "")
             + f". Teeth in contact at the test torque: {int(lm['teeth_in_contact'].min())}–"
-              f"{int(lm['teeth_in_contact'].max())}; largest penetration {fmt(lm['max_penetration_um'].max(), 4)} µm. "
+              f"{int(lm['teeth_in_contact'].max())}; largest penetration {fmt(lm['max_penetration_um'].max(), 4)} µm"
+            + (f", re-found from scratch at ±T {fmt(lm['max_penetration_redetected_um'].max(), 4)} µm"
+               if "max_penetration_redetected_um" in lm else "") + ". "
             + _unsolved_overlap(lm) + _exit_zone_load(lm) + _ball_load(lm) + timing)
 
 

@@ -14,6 +14,7 @@ from hdwf import PARAMETER_COLUMNS
 from hdwf.common.io import atomic_path, read_parquet_meta, write_parquet
 from hdwf.drive.geometry import nominal_geometry
 from hdwf.fe import solve_lost_motion
+from hdwf.fe.bodies import Material
 from hdwf.fe.solver import TOL_GAP
 from hdwf.stages.fe_solve import DesignJob
 from hdwf.study.aggregate import write_lost_motion
@@ -72,7 +73,8 @@ def deformed_stage(job: DesignJob, out_png, out_npz, provenance: dict) -> dict:
     pitch = 2 * np.pi * geom.r_fs_pitch / geom.z_fs
     from hdwf.report.figures import deformed_figure, stamped   # matplotlib only here: the per-design jobs start faster
     with stamped(provenance):
-        deformed_figure(mesh, res.fields, f"{unit} {design_id} at +4 % T_N (Φ = {res.lost_motion_arcmin:.3f} arcmin), "
-                        "true scale", out_png, half_width_mm=2.5 * pitch,
+        deformed_figure(mesh, res.fields, Material(geom.E, geom.nu),
+                        f"{unit} {design_id} at +4 % T_N (Φ = {res.lost_motion_arcmin:.3f} arcmin), true scale", out_png,
+                        half_width_mm=2.5 * pitch,
                         xlim=(geom.r_fs_bore - 2 * geom.module, geom.r_cs_root + 3 * geom.module))
     return {"design_id": design_id, "lost_motion_arcmin": res.lost_motion_arcmin}
