@@ -178,6 +178,17 @@ def test_a_campaign_for_one_drive_refuses_other_drives_and_bad_ids(tmp_path):
     assert len(lines) == 3, lines
 
 
+def test_ids_that_differ_only_in_case_are_refused(tmp_path):
+    """'S1' and 's1' are two specimens to pandas but one file name on macOS and Windows, where one
+    specimen's table would overwrite the other's: the second is refused, naming the first's row."""
+    df = _curve()
+    df.loc[9:, "specimen_id"] = "s1"
+    path = write_table(df, tmp_path)
+    lines = _refused(path, unit="hd42")
+    assert lines == [f"{path}, row 10, field 'specimen_id', value 's1': differs from specimen 'S1' (row 1) only in "
+                     "case; a campaign names files after ids, and macOS and Windows file systems do not tell them apart"]
+
+
 def test_a_curve_logged_at_other_steps_or_run_minus_T_first_needs_no_renumbering():
     """Points are compared with the model at their measured torque: the demo curves (5 steps per
     ramp) against a campaign model of 4 or 8 steps per ramp, or run −T first, have no problem."""

@@ -384,9 +384,14 @@ def _sign_problems(sid: str, rows: pd.DataFrame) -> list[tuple]:
 
 def _drive_problems(data: pd.DataFrame, unit: str) -> list[tuple]:
     """What a campaign for ``unit`` needs: every specimen of that drive, ids that can name a file."""
-    problems = []
+    problems, by_folded_case = [], {}
     for sid, rows in data.groupby("specimen_id", sort=False):
         first = rows.index[0]
+        other = by_folded_case.setdefault(sid.casefold(), (sid, first))
+        if other[0] != sid:
+            problems.append((first + 1, "specimen_id", sid, f"differs from specimen '{other[0]}' (row {other[1] + 1}) "
+                                                            "only in case; a campaign names files after ids, and macOS "
+                                                            "and Windows file systems do not tell them apart"))
         if rows["unit"].iloc[0] in UNITS and rows["unit"].iloc[0] != unit:  # an unknown drive is named already
             problems.append((first + 1, "unit", rows["unit"].iloc[0], f"specimen '{sid}' is not of {unit}, "
                                                                       "the drive these measurements are for"))
