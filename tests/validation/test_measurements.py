@@ -69,6 +69,25 @@ def test_missing_column_and_wrong_unit(tmp_path):
     assert "field 'Gr_mm'" in msg and "missing column" in msg
 
 
+@pytest.mark.parametrize("given, needed", [("rFS_um", "rFS_mm"), ("d_in", "d_mm"), ("D", "D_mm"), ("gr", "Gr_mm")])
+def test_a_parameter_in_another_unit_is_named_not_reported_missing(tmp_path, given, needed):
+    """'rFS_um' is r_FS in micrometres: the problem names the column that is there and what to give,
+    once, and says nothing of a missing 'rFS_mm' (d and D differ only in case, so 'D' is D's)."""
+    df = _curve().rename(columns={needed: given})
+    error, msg = _problems(write_table(df, tmp_path))
+    assert f"field '{given}'" in msg and f"give {needed.removesuffix('_mm')} in mm as '{needed}'" in msg
+    assert "missing column" not in msg and len(error.problems) == 1, msg
+
+
+def test_a_semicolon_separated_file_is_one_problem_naming_the_separator(tmp_path):
+    """European spreadsheets save CSV with ';': one column to the reader. One problem says so, not ten
+    missing columns."""
+    path = tmp_path / "m.csv"
+    _curve().to_csv(path, sep=";", index=False)
+    error, msg = _problems(path)
+    assert len(error.problems) == 1 and "separated by ';', not commas" in msg, msg
+
+
 def test_torque_in_wrong_unit_is_caught_by_size(tmp_path):
     df = _curve()
     df["torque_Nm"] *= 1000  # N·mm given as N·m

@@ -39,24 +39,49 @@ def header_problems(cols: list[str]) -> tuple[str | None, list[tuple]]:
     """The form the columns give, and what is wrong with them: wrong units, missing columns, and
     columns that look meant for the loader but would be ignored (``(row, field, value, message)``,
     as ``MeasurementError`` takes them; row is None)."""
+    cols = [str(c) for c in cols]
+    if len(cols) == 1 and any(sep in cols[0] for sep in (";", "\t", "|")):
+        sep = next(sep for sep in (";", "\t", "|") if sep in cols[0])
+        return None, [(None, None, None, f"the header is one column, {cols[0][:60]!r}: the columns are separated by "
+                                         f"{sep!r}, not commas; save the file as comma-separated CSV")]
     problems = []
     for quantity, (right, wrongs) in _WRONG_UNITS.items():
         for w in wrongs:
             if w in cols and right not in cols:
                 problems.append((None, w, None, f"wrong unit: give {quantity} as '{right}'"))
+    in_other_units = _parameters_in_other_units(cols)
+    for right, found in in_other_units.items():
+        problems.append((None, found, None, f"wrong unit or name: give {right.removesuffix('_mm')} in mm as '{right}'"))
     form = form_of(cols)
     if form is None:
         problems.append((None, None, None,           # no one column is at fault: name none
                          "no measured quantity: need step, torque_Nm, twist_arcmin (curve), or phi_plus_arcmin, "
                          "phi_minus_arcmin, or lost_motion_arcmin; found " + ", ".join(map(str, cols))))
     for c in ID_COLUMNS:
-        if c not in cols:
+        if c not in cols and c not in in_other_units:
             problems.append((None, c, None, "missing column"))
-    problems += _unread_columns(cols, form)
+    problems += _unread_columns(cols, form, set(in_other_units.values()))
     return form, problems
 
 
-def _unread_columns(cols: list[str], form: str | None) -> list[tuple]:
+def _parameters_in_other_units(cols: list[str]) -> dict[str, str]:
+    """Missing parameter columns (``rFS_mm``) given under the same name in another unit or none
+    (``rFS_um``, ``rfs``, ``d_in``): ``{the column needed: the column there}``."""
+    stems = [right.removesuffix("_mm") for right in PARAMETER_COLUMNS]
+    folded = [stem.lower() for stem in stems]
+    found = {}
+    for right, stem in zip(PARAMETER_COLUMNS, stems):
+        if right in cols:
+            continue
+        # d and D differ only in case: their stems must match exactly; the others in any case
+        same = (lambda a, b: a == b) if folded.count(stem.lower()) > 1 else (lambda a, b: a.lower() == b.lower())
+        given = [c for c in cols if c.count("_") <= 1 and same(c.split("_")[0], stem) and c not in PARAMETER_COLUMNS]
+        if given:
+            found[right] = given[0]
+    return found
+
+
+def _unread_columns(cols: list[str], form: str | None, named: set[str] = frozenset()) -> list[tuple]:
     """Columns the loader would ignore that look meant for it: another form's uncertainty, or a read
     column that is absent and mistyped here (``u_twist_arcmn``, ``Torque_Nm``). Ignored, their values
     would be lost unseen. With no form, every form's columns are candidates."""
@@ -64,7 +89,7 @@ def _unread_columns(cols: list[str], form: str | None) -> list[tuple]:
         read = [*ID_COLUMNS, *(c for cs in FORMS.values() for c in cs), *dict.fromkeys(UNCERTAINTY_COLUMN.values())]
     else:
         read = [*ID_COLUMNS, *FORMS[form], UNCERTAINTY_COLUMN[form]]
-    wrong_units = {w for _, wrongs in _WRONG_UNITS.values() for w in wrongs}   # named as such above
+    wrong_units = {w for _, wrongs in _WRONG_UNITS.values() for w in wrongs} | named   # named as such above
     absent = {r.lower(): r for r in read if r not in cols}
     problems = []
     for c in map(str, cols):
