@@ -87,6 +87,39 @@ def test_iteration_limit_gives_failed_status():
     assert math.isnan(r.lost_motion_arcmin)
 
 
+def test_a_mount_whose_cam_rows_never_settle_gives_failed_status(monkeypatch):
+    """The cam rows re-detected after each mount solve move by 0.1 µm more each time (above the
+    1e-6 mm the loop settles to): after its six tries the mount must fail, not go on from rows
+    its last solve did not use."""
+    import dataclasses
+
+    import hdwf.fe.cycle as cycle
+    calls = []
+
+    def drifting(*args, **kw):
+        rows = cam_rows(*args, **kw)
+        calls.append(1)
+        return dataclasses.replace(rows, g0=rows.g0 + 1e-4 * len(calls))
+
+    cam_rows = cycle.cam_rows
+    monkeypatch.setattr(cycle, "cam_rows", drifting)
+    g = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.005, 0.005)
+    r = solve_lost_motion(g, build_mesh(g, **COARSE, symmetry="half"), steps_per_ramp=1)
+    assert r.status == "failed" and "cam rows still moved 0.1000 um after 6" in r.reason
+    assert math.isnan(r.lost_motion_arcmin) and len(calls) == 7
+
+
+def test_teeth_that_stay_inside_each_other_at_the_test_torque_give_failed_status(monkeypatch):
+    """The bare section re-pairs its teeth at ±T while the independent check finds them inside each
+    other; if 1 µm is still found after three re-linearisations the solve must fail, not report Φ."""
+    import hdwf.fe.relinearise as relinearise
+    monkeypatch.setattr(relinearise, "penetration", lambda model, level, check: 1e-3)
+    g = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.005, 0.005)
+    r = solve_lost_motion(g, build_mesh(g, **COARSE, symmetry="half"), steps_per_ramp=1)
+    assert r.status == "failed" and "re-found 1.000 um inside each other after 3 re-linearisations" in r.reason
+    assert math.isnan(r.lost_motion_arcmin)
+
+
 def test_a_level_that_needs_more_iterations_is_solved_at_the_last_try(monkeypatch):
     """A torque level whose active set fills too slowly for the iteration limit, at every cut-back,
     is solved once more with LAST_TRY_ITER_FACTOR times the limit: the result is the one an

@@ -16,8 +16,9 @@ the torque halfway from the last one (``LostMotionModel.solve_level_stepped``). 
 starts from the mount's rows again: rows settled at +T fit that state only.  Frictionless, a
 level on the way back is then the way up's problem at that torque (same rows, same load;
 elastic contact without friction has one solution), so it is not solved again.  Without preload (and in the coning
-slices) the near pairs are re-linearised once at +-T if more than 0.05 um penetration is
-re-detected, and those rows are kept for the way back (``redetect_teeth``).
+slices) the near pairs are re-linearised at +-T while more than 0.05 um penetration is
+re-detected (at most three times, then the solve fails), and those rows are kept for the way
+back (``redetect_teeth``).
 
 The frictionless FS is indifferent inside the backlash at zero torque; zero-torque steps
 use 1e-3 of the test torque in the direction of the last load (the state an
@@ -46,7 +47,7 @@ from hdwf.fe.model import ZONE_DEG, LostMotionModel, SharedBodies
 from hdwf.fe.preload import PRELOAD_ZONE_DEG, mount_with_cutback, overlap_outside_zones, with_flank_friction
 from hdwf.fe.relinearise import redetect_teeth, settle_teeth
 from hdwf.fe.series import series_output_twist
-from hdwf.fe.solver import TOL_GAP, LevelSolution
+from hdwf.fe.solver import TOL_GAP, ContactFailure, LevelSolution
 
 ZERO_TORQUE_BIAS = 1e-3  # fraction of the test torque used at the zero-torque steps
 EXIT_ARC_DEG = 45.0      # a tooth loaded farther from a major axis is a tip crossing, not the working mesh
@@ -134,6 +135,9 @@ def mount_wave_generator(model: LostMotionModel,
         if change < 1e-6 and geo_it > 0:
             break
         model.replace_rows("cam", new)
+    else:   # the last solve used rows that no longer fit its state: no silent mount
+        raise ContactFailure(f"wave generator mount: cam rows still moved {change * 1000:.4f} um after "
+                             f"{geo_it + 1} re-linearisations")
     fs = model.bodies["fs"]
     bore = fs.body_mesh.node_sets["fs_bore"]
     j0 = bore[np.argmin((fs.x[0, bore] - geom.r_fs_bore) ** 2 + fs.x[1, bore] ** 2)]

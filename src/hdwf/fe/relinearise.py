@@ -15,7 +15,8 @@ the tolerance the gaps are moved to the re-detected ones (a modified-Newton step
 no back-substitution) as long as that halves the error, and otherwise the pairs near
 contact are re-paired and re-linearised (new normals and segments).  Its fixed point is the
 true gap at the solution.  ``settle_teeth`` applies it at +-T with preloaded teeth;
-``redetect_teeth`` is the single re-linearisation the bare section and the coning slices keep.
+``redetect_teeth`` is the re-linearisation the bare section and the coning slices keep: the near
+pairs re-paired at +-T while they re-detect a penetration, at most three times.
 """
 
 from __future__ import annotations
@@ -166,13 +167,17 @@ def redetect_teeth(model: LostMotionModel, torque: float,
     along each other; if the linearised pairing then misses more than ``GEO_TOL``, re-pair
     and re-linearise the tooth pairs within ``GEO_NEAR`` of contact about this state and solve the level again.
 
-    Returns the final level and its re-detected penetration (mm)."""
+    Returns the final level and its re-detected penetration (mm); raises ``ContactFailure`` if
+    three re-linearisations leave more than ``GEO_TOL``."""
     geom = model.geometry
     for relin in range(4):
         chk = tooth_rows(model.structure, geom, level.u_watch, np.inf)
         pen_nl = penetration(model, level, chk)
-        if pen_nl <= GEO_TOL or relin == 3:
+        if pen_nl <= GEO_TOL:
             break
+        if relin == 3:
+            raise ContactFailure(f"torque {torque / 1000:.1f} N m: tooth pairs re-found {pen_nl * 1000:.3f} um "
+                                 f"inside each other after {relin} re-linearisations")
         tr = model.rows["tooth"]
         new = tooth_rows(model.structure, geom, level.u_watch, np.inf, nodes=tr.slave_nodes)
         # only pairs at or near contact are re-linearised; the open flanks

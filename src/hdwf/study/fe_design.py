@@ -45,6 +45,7 @@ def solve_design(unit: str, params: Mapping[str, float], mesh: DriveMesh, steps_
            "lost_motion_arcmin": res.lost_motion_arcmin if ok else np.nan,
            "status": "ok" if ok else f"failed: {res.reason}",
            "teeth_in_contact": int(res.teeth_in_contact), "max_penetration_um": float(res.max_penetration_um),
+           "max_penetration_redetected_um": float(res.max_penetration_redetected_um),
            "overlap_outside_zones_um": float(res.overlap_outside_zones_um),
            "loaded_arc_deg": float(res.loaded_arc_deg),
            "ball_load_max_N": float(res.max_ball_load_N), "ball_pressure_max_MPa": float(res.max_ball_pressure_MPa),
