@@ -280,8 +280,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"hdwf {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     for name, func, help_ in (("check-config", _check_config, "validate a config file, the paper's tables and every "
-                               "campaign's measurements (relative paths start at the nearest folder holding a "
-                               "Snakefile, as in the workflow)"),
+                               "campaign's measurements (the config files are named from the current folder; the "
+                               "paths inside them start at the nearest folder holding a Snakefile, as in the "
+                               "workflow)"),
                               ("provenance", _provenance, "print config hash, git commit and package versions")):
         p = sub.add_parser(name, help=help_, description=help_[0].upper() + help_[1:] + ".")
         p.add_argument("config", nargs="*", default=["config.yaml"],

@@ -56,7 +56,7 @@ def test_every_problem_is_reported_and_the_file_is_untouched(tmp_path):
     before = hashlib.sha256(path.read_bytes()).hexdigest()
     err, msg = _problems(path)
     assert "m.csv, row 4, field 'twist_arcmin'" in msg
-    assert "m.csv, row 6, field 'step', value 4" in msg and "duplicate step" in msg
+    assert "m.csv, row 6, field 'step', value 4:" in msg and "duplicate step" in msg   # 4, not 4.0
     assert "m.csv, row 12, field 'unit', value 'hd50'" in msg and "unknown drive" in msg
     assert "m.csv, row 14, field 'rFS_mm', value 0.5" in msg and "outside what the model supports" in msg
     assert hashlib.sha256(path.read_bytes()).hexdigest() == before

@@ -345,7 +345,9 @@ def _curve_problems(data: pd.DataFrame, sid: str, rows: pd.DataFrame) -> list[tu
     problems = []
     first = rows.index[0]
     for i in rows.index[rows["step"].duplicated().to_numpy()]:
-        problems.append((i + 1, "step", data.at[i, "step"], f"duplicate step in specimen '{sid}'"))
+        step = data.at[i, "step"]
+        step = int(step) if float(step).is_integer() else step   # 3 as the file has it, not 3.0
+        problems.append((i + 1, "step", step, f"duplicate step in specimen '{sid}'"))
     unit = rows["unit"].iloc[0]
     if unit not in UNITS or not np.isfinite(rows["torque_Nm"]).all():
         return problems
