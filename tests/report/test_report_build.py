@@ -607,3 +607,28 @@ def test_the_deformed_picture_colours_the_stress_the_torque_adds(monkeypatch):
     assert len(coloured) == 1 and coloured[0].get_array().size > 100
     assert np.asarray(coloured[0].get_array()) == pytest.approx(100.0, rel=1e-9)
     assert drawn[0].axes[1].get_ylabel() == "von Mises stress added by the test torque (MPa)"
+
+
+def test_the_residual_panels_stay_legible_at_page_width(monkeypatch):
+    """Six panels in one row of an 18-inch figure printed at page width left 4-pt tick labels; three a
+    row keep every panel about 3 inches wide. A curve campaign (five inputs and the curve) fills two
+    rows; a Φ campaign's five inputs leave the sixth cell hidden."""
+    import numpy as np
+    import pandas as pd
+
+    from hdwf import PARAMETER_COLUMNS
+    from hdwf.report import figures
+
+    drawn = []
+    monkeypatch.setattr(figures, "_save", lambda fig, path: drawn.append(fig))
+    rng = np.random.default_rng(3)
+    pts = pd.DataFrame({"specimen_id": np.repeat(["a", "b", "c"], 4), "D": rng.normal(size=12),
+                        "S_model": rng.normal(size=12), "S_final": rng.normal(size=12),
+                        **{c: np.repeat(rng.uniform(size=3), 4) for c in PARAMETER_COLUMNS},
+                        "torque_Nm": np.tile([0.0, 0.96, 0.0, -0.96], 3), "branch": np.tile(["load+"] * 2 + ["load-"] * 2, 3)})
+    figures.residual_figure(pts, "t", "a.png")
+    figures.residual_figure(pts.drop(columns=["torque_Nm", "branch"]), "t", "b.png")
+    for fig, shown in zip(drawn, (6, 5)):
+        visible = [ax for ax in fig.axes if ax.get_visible()]
+        assert len(visible) == shown and len(fig.axes) == 6
+        assert fig.get_figwidth() / 3 >= 2.9

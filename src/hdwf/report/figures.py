@@ -347,8 +347,13 @@ def residual_figure(points: pd.DataFrame, title: str, path) -> None:
         The figure's title and PNG file.
     """
     curve = "torque_Nm" in points.columns and points["torque_Nm"].notna().any()
-    ncol = len(PARAMETERS) + (1 if curve else 0)
-    fig, axes = plt.subplots(1, ncol, figsize=(3 * ncol, 3.2), sharey=True, layout="constrained")
+    panels = len(PARAMETERS) + (1 if curve else 0)
+    # three panels a row: six in one row left tick labels of 4 pt on a printed page
+    nrows = -(-panels // 3)
+    fig, grid = plt.subplots(nrows, 3, figsize=(9, 3.2 * nrows), sharey=True, layout="constrained", squeeze=False)
+    axes = list(grid.ravel()[:panels])
+    for spare in grid.ravel()[panels:]:
+        spare.set_visible(False)
     r0 = points["D"] - points["S_model"]
     r1 = points["D"] - points["S_final"]
     spec = points.assign(r0=r0, r1=r1).groupby("specimen_id").agg(
@@ -360,7 +365,8 @@ def residual_figure(points: pd.DataFrame, title: str, path) -> None:
         ax.set_xlabel(_label(p))
         ax.ticklabel_format(axis="x", useOffset=False)
         ax.tick_params(axis="x", labelrotation=30)
-    axes[0].set_ylabel("mean residual D − S (arcmin)")
+    for row in grid:
+        row[0].set_ylabel("mean residual D − S (arcmin)")
     if curve:
         ax = axes[-1]
         pts = points.assign(r0=r0)
