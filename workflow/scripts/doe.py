@@ -1,7 +1,7 @@
 """Rule doe: Table 3 bounds -> optimal LHS (hdwf.stages.doe.doe_stage)."""
 import logging
 
-from _helpers import mock_snakemake, setup
+from _helpers import folder_of, mock_snakemake, setup
 
 from hdwf.stages.doe import doe_stage
 from hdwf.study.paper import table3_bounds
@@ -11,7 +11,7 @@ if "snakemake" not in globals():  # run by hand, e.g. to debug one step (see _he
 
 prov = setup(snakemake)
 unit = snakemake.wildcards.unit
-bounds = table3_bounds(snakemake.config["paper_data"], unit)
+bounds = table3_bounds(folder_of(snakemake.input.bounds), unit)   # the declared input, so an edit re-runs it
 df = doe_stage(bounds, snakemake.params.n, snakemake.params.seed, snakemake.params.optimization,
                snakemake.output[0], prov, unit)
 logging.info("wrote %d designs for %s", len(df), unit)
