@@ -30,6 +30,7 @@ Phi = phi + phi'.  The modules, from the bottom up:
 * ``series``: elements in series between the FS rim and the output (spring, dead band, micro-slip);
 * ``cycle``: the test itself, ``solve_lost_motion`` and ``solve_lost_motion_variants``;
 * ``coning``: the quasi-3D cup, slices along the face width on one twist (``ModelChanges.coning_slope``).
+* ``stress``: the von Mises stress of a displacement field, element by element (the report's picture).
 
 Half model (``mesh.symmetry == "half"``, hand-written): the drive and its load are
 invariant under the rotation by pi about the axis (even tooth and ball counts, pi-periodic
