@@ -281,7 +281,7 @@ def deformed_figure(mesh, fields: dict, material: Material, title: str, path, ha
         for sgn in images:
             p, t = sgn * body.mesh.p, body.mesh.t
             x = p + magnify * sgn * plus[name]
-            corners = p[:, t]     # a triangle is drawn if its box meets the window (large ring elements too)
+            corners = x[:, t]     # drawn if its box, where it is drawn, meets the window (large ring elements too)
             keep = ((corners[0].max(axis=0) > xlim[0]) & (corners[0].min(axis=0) < xlim[1])
                     & (corners[1].max(axis=0) > -ymax) & (corners[1].min(axis=0) < ymax))
             tri = x[:, t[:, keep]].transpose(2, 1, 0)  # (n, 3, 2)
