@@ -326,9 +326,12 @@ def test_ladder_names_the_rungs_whose_solve_failed():
     rung and specimen, and says nothing when every rung solved or the ladder predates the column."""
     import pandas as pd
     from hdwf.report.validation_part import _failed_rungs_sentence
-    lad = pd.DataFrame({"rung": [0, 1], "model": ["baseline", "with preload"], "failed_specimens": ["", "paper-03"]})
+    lad = pd.DataFrame({"rung": [0, 1], "model": ["baseline", "with preload"], "failed_specimens": ["", "paper-03"],
+                        "delta_bic_against_rung": [0, 0]})
     said = _failed_rungs_sentence(lad)
-    assert "rung 1 (with preload) for paper-03" in said and "rung 0" not in said
+    assert "rung 1 (with preload) for paper-03" in said and "rung 0" not in said and "ΔBIC" not in said
+    first_failed = lad.assign(failed_specimens=["paper-03", ""], delta_bic_against_rung=[1, 1])
+    assert "ΔBIC is taken against rung 1, the first that solved every specimen" in _failed_rungs_sentence(first_failed)
     assert _failed_rungs_sentence(lad.iloc[:1]) == ""
     assert _failed_rungs_sentence(lad.drop(columns=["failed_specimens"])) == ""
 
@@ -349,6 +352,9 @@ def test_the_one_sentence_verdict_gives_the_ladders_re_solved_error_beside_the_t
     assert said.endswith("the last rung of the ladder below has RMSE 0.1986 arcmin.")
     doc = Document("t", "s", PROVENANCE)
     signature_section(doc, {**diag, "verdict": {"found_in_order": []}}, 0.198643)
+    assert "ladder" not in doc.blocks[-1]["text"]
+    doc = Document("t", "s", PROVENANCE)
+    signature_section(doc, diag, float("nan"))     # the last rung failed: no "RMSE – arcmin"
     assert "ladder" not in doc.blocks[-1]["text"]
 
 
@@ -559,6 +565,11 @@ def test_the_summary_gathers_each_parts_headline_figure(named_inputs, tmp_path):
     ladder = next(r for r in rows if r[0].startswith("`paper_hd42` (HD 42)"))
     assert ladder[1:4] == ["8.960 → 0.194 arcmin (46.19×)", "stated noise 0.190 arcmin", "–"]
     assert ladder[0].endswith(f"found preload, {lit('fs_cup_torsion')}")
+    pd.DataFrame({"rmse_arcmin": [8.96, 0.52, float("nan")]}).to_parquet(tmp_path / "ladder.parquet")
+    doc = Document("t", "s", PROVENANCE)     # the last rung failed: no fall made up from a missing error
+    summary_section(doc, report)
+    rows = next(b for b in doc.blocks if b["type"] == "table")["rows"]
+    assert next(r for r in rows if r[0].startswith("`paper_hd42` (HD 42)"))[1] == "a rung's solve failed: no fall to give"
 
 
 def test_a_campaign_on_a_coarser_mesh_than_the_studies_says_what_that_costs():

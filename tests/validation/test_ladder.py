@@ -73,3 +73,15 @@ def test_a_rung_whose_solve_failed_for_a_specimen_has_no_error():
     assert lad["solved"].tolist() == [True, False]
     assert lad["failed_specimens"].tolist() == ["", "s2"]
     assert lad.loc[1, ["rmse_arcmin", "bias_arcmin", "max_abs_arcmin", "delta_bic"]].isna().all()
+
+
+def test_a_failed_baseline_leaves_the_later_rungs_comparable():
+    """The bare rung fails for s2: it has no BIC, so ΔBIC is taken against the first rung that solved
+    every specimen (the preload, ΔBIC 0 there) and the ladder says which rung that is."""
+    meas, table = _campaign()
+    failed = (table["specimen_id"] == "s2") & (table["variant"] == variant_key({}))
+    table.loc[failed, "twist_arcmin"] = np.nan
+    lad = ladder_table(meas, table, ladder_variants({}, [("preload", {"interference_m": 0.2})]))
+    assert np.isnan(lad.loc[0, "delta_bic"]) and lad.loc[1, "delta_bic"] == 0.0
+    assert lad["delta_bic_against_rung"].tolist() == [1, 1]
+    assert lad.loc[1, "rmse_arcmin"] == pytest.approx(0.1)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
 import pandas as pd
 
 from hdwf.common.io import read_json
@@ -80,7 +81,8 @@ def _campaigns(report: ReportInputs) -> list[Finding]:
         diag = read_json(campaign.diagnosis)
         rmse = pd.read_parquet(campaign.ladder)["rmse_arcmin"].to_numpy(float)
         named = diag.get("verdict", {}).get("found_in_order") or []
-        value = f"{fmt(rmse[0], 3)} → {fmt(rmse[-1], 3)} arcmin ({fmt(rmse[0] / rmse[-1], 2)}×)"
+        value = (f"{fmt(rmse[0], 3)} → {fmt(rmse[-1], 3)} arcmin ({fmt(rmse[0] / rmse[-1], 2)}×)"
+                 if np.isfinite(rmse[[0, -1]]).all() else "a rung's solve failed: no fall to give")
         noise, estimate = diag.get("noise_arcmin"), (diag.get("detectability") or {}).get("noise_arcmin")
         found.append(Finding(f"`{campaign.name}` ({UNIT_NAMES[diag['unit']]}): RMSE, bare model to the last rung; "
                              f"found {', '.join(lit(n) for n in named) if named else 'nothing'}", value,

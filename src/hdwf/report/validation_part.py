@@ -5,6 +5,7 @@ error ladder), all read from the campaign's ``diagnosis.json``, ladder and figur
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import pandas as pd
@@ -243,7 +244,8 @@ def signature_section(doc: Document, diag: dict, solved_final_rmse_arcmin: float
     if sig["noise"]["flag"]:
         doc.text(f"Caution: {lit(sig['noise']['note'])}.")
     if sig.get("text"):
-        solved = ("" if solved_final_rmse_arcmin is None or not diag.get("verdict", {}).get("found_in_order") else
+        solved = ("" if solved_final_rmse_arcmin is None or not math.isfinite(solved_final_rmse_arcmin)
+                  or not diag.get("verdict", {}).get("found_in_order") else
                   f" Re-solved with the FE model, the last rung of the ladder below has RMSE "
                   f"{fmt(solved_final_rmse_arcmin, 4)} arcmin.")
         doc.text(f"In one sentence: {lit(sig['text'])}.{solved}")
@@ -316,8 +318,12 @@ def _failed_rungs_sentence(ladder: pd.DataFrame) -> str:
         return ""
     failed = [f"rung {r['rung']} ({lit(r['model'])}) for {lit(r['failed_specimens'])}"
               for r in ladder.to_dict("records") if r["failed_specimens"]]
-    return (f"*No error is given where a rung's solve failed:* {'; '.join(failed)} (see their tables' status)."
-            if failed else "")
+    if not failed:
+        return ""
+    against = int(ladder["delta_bic_against_rung"].iloc[0]) if "delta_bic_against_rung" in ladder else 0
+    basis = ("" if against == 0 else " No rung solved every specimen, so no ΔBIC is given." if against < 0 else
+             f" ΔBIC is taken against rung {against}, the first that solved every specimen.")
+    return f"*No error is given where a rung's solve failed:* {'; '.join(failed)} (see their tables' status).{basis}"
 
 
 def _bearing_sentence(ladder: pd.DataFrame) -> str:

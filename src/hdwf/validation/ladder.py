@@ -61,7 +61,8 @@ def ladder_table(meas: Measurements, table: pd.DataFrame, rungs: list[tuple[str,
     -------
     pandas.DataFrame
         ``rung``, ``model``, ``effects`` (JSON), ``n_params``, ``rmse_arcmin``, ``bias_arcmin``,
-        ``max_abs_arcmin``, ``delta_bic`` (against the first rung), ``solved``,
+        ``max_abs_arcmin``, ``delta_bic`` (against the first rung that solved every specimen,
+        ``delta_bic_against_rung``; -1 when none did), ``solved``,
         ``failed_specimens`` (comma-separated; empty when every solve succeeded), and the bearing
         check of the rung's model (``bearing_check``): the largest ball pressure at the mount over
         the specimens and how many exceed ISO 76's static rating. A rung whose solve failed for
@@ -70,21 +71,25 @@ def ladder_table(meas: Measurements, table: pd.DataFrame, rungs: list[tuple[str,
     """
     obs = observation_frame(meas)
     D = obs["D"].to_numpy(float)
-    rows, b0 = [], None
+    rows = []
     for k, (label, eff) in enumerate(rungs):
         S = predict(table, obs, variant_key(eff))
         n_par = sum(len(v) for v in eff.values())
         solved = np.isfinite(S)
         E = np.where(solved.all(), S - D, np.nan)
-        b = bic(float(np.sum(E ** 2)), len(D), n_par)
-        b0 = b if b0 is None else b0
         rows.append({"rung": k, "model": label, "effects": json.dumps(eff, sort_keys=True),
                      "n_params": n_par, "rmse_arcmin": float(np.sqrt(np.mean(E ** 2))),
                      "bias_arcmin": float(np.mean(E)), "max_abs_arcmin": float(np.max(np.abs(E))),
-                     "delta_bic": float(b - b0), "solved": bool(solved.all()),
+                     "bic": bic(float(np.sum(E ** 2)), len(D), n_par), "solved": bool(solved.all()),
                      "failed_specimens": ", ".join(sorted(set(obs["specimen_id"].to_numpy()[~solved]))),
                      **bearing_check(table, variant_key(eff))})
-    return pd.DataFrame(rows)
+    ladder = pd.DataFrame(rows)
+    # against the first rung that has a BIC: a failed baseline leaves the later rungs comparable
+    finite = ladder["bic"].notna()
+    ladder.insert(ladder.columns.get_loc("bic"), "delta_bic",
+                  ladder["bic"] - (ladder.loc[finite, "bic"].iloc[0] if finite.any() else np.nan))
+    ladder["delta_bic_against_rung"] = int(ladder.loc[finite, "rung"].iloc[0]) if finite.any() else -1
+    return ladder.drop(columns="bic")
 
 
 def bearing_check(table: pd.DataFrame, key: str) -> dict:
