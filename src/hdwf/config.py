@@ -77,7 +77,9 @@ def blame(sources: list[str | Path], field: str, value=None) -> str:
 
     If that file sets it to another value than the offending ``value``, ``--config`` on the
     command line overrode it. A bad key name (an unknown effect, a campaign name with a space) is
-    reported as the mapping's field with the key as its value: the file that holds that key set it.
+    reported as the mapping's field with the key as its value, or as its own field: the file that
+    holds that key set it. Mappings merge across the files, so a mapping without the key sends the
+    search on to the files before; a list or a value replaces the earlier ones'.
     """
     for path in reversed(sources):
         try:
@@ -92,8 +94,13 @@ def blame(sources: list[str | Path], field: str, value=None) -> str:
             else:
                 break
         else:
-            names_the_key = isinstance(node, dict) and isinstance(value, str) and value in node
-            return str(path) if value is None or node == value or names_the_key else "--config (command line)"
+            if value is None or node == value or field.rsplit(".", 1)[-1] == str(value):
+                return str(path)
+            if isinstance(node, (dict, list)) and isinstance(value, (str, int, float)) and value in node:
+                return str(path)
+            if isinstance(node, dict):
+                continue
+            return "--config (command line)"
     return "--config (command line)"
 
 

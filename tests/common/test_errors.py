@@ -94,6 +94,35 @@ def test_a_bad_key_name_is_blamed_on_the_config_file_that_holds_it(tmp_path):
     assert exc.value.file == "--config (command line)"
 
 
+@pytest.mark.parametrize("overlay, change", [
+    ("fe:\n  effects:\n    preload: {interference_mm: 0.3}\n",                  # a bad parameter name
+     lambda c: c["fe"]["effects"].update(preload={"interference_mm": 0.3})),
+    ("validation:\n  demo:\n    candidates: [thermal, themal]\n",               # a bad name in a list
+     lambda c: c["validation"]["demo"].update(candidates=["thermal", "themal"])),
+])
+def test_a_bad_name_in_an_overlay_is_blamed_on_it(tmp_path, overlay, change):
+    path = tmp_path / "overlay.yaml"
+    path.write_text(overlay)
+    config = yaml.safe_load((ROOT / "config.yaml").read_text())
+    change(config)
+    with pytest.raises(ConfigError) as exc:
+        validate_config(config, SCHEMA, [ROOT / "config.yaml", path])
+    assert exc.value.file == str(path), exc.value
+
+
+def test_a_bad_key_in_the_base_is_blamed_on_it_under_an_overlay_that_does_not_set_it(tmp_path):
+    """Mappings merge: an overlay that sets other campaigns' keys does not hide the base's bad one."""
+    base, overlay = tmp_path / "base.yaml", tmp_path / "overlay.yaml"
+    config = yaml.safe_load((ROOT / "config.yaml").read_text())
+    config["validation"]["my camp"] = {"unit": "hd42", "measurements": "data/validation/demo_hd42.csv"}
+    base.write_text(yaml.safe_dump(config))
+    overlay.write_text("validation:\n  demo:\n    rounds: 2\n")
+    config["validation"]["demo"]["rounds"] = 2
+    with pytest.raises(ConfigError) as exc:
+        validate_config(config, SCHEMA, [base, overlay])
+    assert exc.value.file == str(base) and exc.value.value == "my camp"
+
+
 def _copy_tables(tmp_path):
     dst = tmp_path / "paper"
     shutil.copytree(ROOT / "data" / "paper", dst)
