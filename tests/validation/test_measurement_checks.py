@@ -187,6 +187,9 @@ def test_ids_that_differ_only_in_case_are_refused(tmp_path):
     lines = _refused(path, unit="hd42")
     assert lines == [f"{path}, row 10, field 'specimen_id', value 's1': differs from specimen 'S1' (row 1) only in "
                      "case; a campaign names files after ids, and macOS and Windows file systems do not tell them apart"]
+    df.loc[:8, "specimen_id"], df.loc[9:, "specimen_id"] = "Straße", "STRASSE"   # not ids at all, not a case clash
+    lines = _refused(write_table(df, tmp_path), unit="hd42")
+    assert not any("only in case" in line for line in lines) and any("specimen ids may use" in line for line in lines)
 
 
 def test_a_curve_logged_at_other_steps_or_run_minus_T_first_needs_no_renumbering():

@@ -79,6 +79,14 @@ def test_a_parameter_in_another_unit_is_named_not_reported_missing(tmp_path, giv
     assert "missing column" not in msg and len(error.problems) == 1, msg
 
 
+def test_a_note_column_is_not_taken_for_a_parameter_in_another_unit(tmp_path):
+    """'gr_note' shares Gr's stem but is no unit: with Gr_mm missing the file is refused for that, and
+    the note is not named as Gr given wrongly."""
+    df = _curve().rename(columns={"Gr_mm": "gr_note"})
+    error, msg = _problems(write_table(df, tmp_path))
+    assert "field 'Gr_mm'" in msg and "missing column" in msg and "gr_note" not in msg, msg
+
+
 def test_a_semicolon_separated_file_is_one_problem_naming_the_separator(tmp_path):
     """European spreadsheets save CSV with ';': one column to the reader. One problem says so, not ten
     missing columns."""

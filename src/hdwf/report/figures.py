@@ -24,7 +24,9 @@ from hdwf.study.knee import HingeFit
 # Files only, never a window: the same backend on every machine, whatever MPLBACKEND says.
 matplotlib.use("Agg")
 
-_PNG_META = {"Software": None}  # no version string in the file: same data, same bytes
+# No "Software" chunk: the bytes hang on the data and on the provenance stamped (``stamped``:
+# config hash, commit, package versions), not on matplotlib writing its own name and version.
+_PNG_META = {"Software": None}
 PROVENANCE_TEXT_KEY = "hdwf.provenance"
 _provenance: ContextVar[str | None] = ContextVar("figure_provenance", default=None)
 

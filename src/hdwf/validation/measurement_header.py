@@ -21,6 +21,8 @@ _WRONG_UNITS = {
     "twist": ("twist_arcmin", ["twist_deg", "twist_rad", "twist_arcsec", "twist_mrad", "twist_urad", "twist"]),
     "lost_motion": ("lost_motion_arcmin", ["lost_motion_deg", "lost_motion_arcsec", "lost_motion_rad"]),
 }
+# The units a parameter column may come in by mistake ('rFS_um', 'd_in'): only these are read as one.
+_LENGTH_UNITS = {"m", "cm", "um", "µm", "micron", "microns", "nm", "in", "inch", "mil", "mils", "thou"}
 # How alike (difflib's ratio) an unread column must be to a read one to be taken for a typo of it:
 # one wrong, missing or swapped letter in a name of 8 or more ('u_twist_arcmn' 0.96, 'Torque_Nm'
 # 0.89), not two names that merely share a unit ('u_arcmin' and 'u_twist_arcmin' 0.73).
@@ -75,7 +77,8 @@ def _parameters_in_other_units(cols: list[str]) -> dict[str, str]:
             continue
         # d and D differ only in case: their stems must match exactly; the others in any case
         same = (lambda a, b: a == b) if folded.count(stem.lower()) > 1 else (lambda a, b: a.lower() == b.lower())
-        given = [c for c in cols if c.count("_") <= 1 and same(c.split("_")[0], stem) and c not in PARAMETER_COLUMNS]
+        given = [c for c in cols if c not in PARAMETER_COLUMNS and same(c.split("_")[0], stem)
+                 and (c.count("_") == 0 or c.split("_", 1)[1].lower() in _LENGTH_UNITS)]
         if given:
             found[right] = given[0]
     return found

@@ -389,7 +389,8 @@ def _drive_problems(data: pd.DataFrame, unit: str) -> list[tuple]:
     problems, by_folded_case = [], {}
     for sid, rows in data.groupby("specimen_id", sort=False):
         first = rows.index[0]
-        other = by_folded_case.setdefault(sid.casefold(), (sid, first))
+        # ids outside the pattern are refused below; within it (ASCII) case is all that can differ
+        other = by_folded_case.setdefault(sid.lower(), (sid, first)) if re.fullmatch(SPECIMEN_ID_PATTERN, sid) else (sid,)
         if other[0] != sid:
             problems.append((first + 1, "specimen_id", sid, f"differs from specimen '{other[0]}' (row {other[1] + 1}) "
                                                             "only in case; a campaign names files after ids, and macOS "
