@@ -109,15 +109,20 @@ def test_a_mount_whose_cam_rows_never_settle_gives_failed_status(monkeypatch):
     assert math.isnan(r.lost_motion_arcmin) and len(calls) == 7
 
 
-def test_teeth_that_stay_inside_each_other_at_the_test_torque_give_failed_status(monkeypatch):
-    """The bare section re-pairs its teeth at ±T while the independent check finds them inside each
-    other; if 1 µm is still found after three re-linearisations the solve must fail, not report Φ."""
+@pytest.mark.parametrize("found_um, fails", [(1.0, True), (0.4, False)])
+def test_teeth_that_stay_inside_each_other_at_the_test_torque_give_failed_status(monkeypatch, found_um, fails):
+    """The bare section re-pairs its teeth at ±T while the check from scratch finds them inside each
+    other. 1 µm left after three re-linearisations (0.17 arcmin of twist on HD 42) must fail the solve,
+    not report Φ; 0.4 µm, within the 0.5 µm limit, is solved and recorded in the result."""
     import hdwf.fe.relinearise as relinearise
-    monkeypatch.setattr(relinearise, "penetration", lambda model, level, check: 1e-3)
+    monkeypatch.setattr(relinearise, "penetration", lambda model, level, check: found_um * 1e-3)
     g = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.005, 0.005)
     r = solve_lost_motion(g, build_mesh(g, **COARSE, symmetry="half"), steps_per_ramp=1)
-    assert r.status == "failed" and "re-found 1.000 um inside each other after 3 re-linearisations" in r.reason
-    assert math.isnan(r.lost_motion_arcmin)
+    if fails:
+        assert r.status == "failed" and "re-found 1.000 um inside each other, beyond the 0.5 um" in r.reason
+        assert math.isnan(r.lost_motion_arcmin)
+    else:
+        assert r.status == "ok" and r.max_penetration_redetected_um == pytest.approx(0.4)
 
 
 def test_a_level_that_needs_more_iterations_is_solved_at_the_last_try(monkeypatch):

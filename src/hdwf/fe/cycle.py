@@ -17,8 +17,8 @@ starts from the mount's rows again: rows settled at +T fit that state only.  Fri
 level on the way back is then the way up's problem at that torque (same rows, same load;
 elastic contact without friction has one solution), so it is not solved again.  Without preload (and in the coning
 slices) the near pairs are re-linearised at +-T while more than 0.05 um penetration is
-re-detected (at most three times, then the solve fails), and those rows are kept for the way
-back (``redetect_teeth``).
+re-detected (at most three times), and those rows are kept for the way back
+(``redetect_teeth``).  Teeth re-found more than 0.5 um inside each other fail the solve.
 
 The frictionless FS is indifferent inside the backlash at zero torque; zero-torque steps
 use 1e-3 of the test torque in the direction of the last load (the state an
@@ -45,7 +45,7 @@ from hdwf.fe.contact_rows import ball_rows, cam_rows, fit_rows, tooth_rows
 from hdwf.fe.hertz import ball_max_pressure
 from hdwf.fe.model import ZONE_DEG, LostMotionModel, SharedBodies
 from hdwf.fe.preload import PRELOAD_ZONE_DEG, mount_with_cutback, overlap_outside_zones, with_flank_friction
-from hdwf.fe.relinearise import redetect_teeth, settle_teeth
+from hdwf.fe.relinearise import REDETECTED_LIMIT, redetect_teeth, settle_teeth
 from hdwf.fe.series import series_output_twist
 from hdwf.fe.solver import TOL_GAP, ContactFailure, LevelSolution
 
@@ -207,6 +207,9 @@ def _torque_test(model: LostMotionModel, frac: np.ndarray, mounted: MountedWaveG
             level, pen_nl = redetect_teeth(model, T, level)
             active = level.active
             maxpen_nl = max(maxpen_nl, pen_nl)
+        if at_full_torque and maxpen_nl > REDETECTED_LIMIT:
+            raise ContactFailure(f"torque {T / 1000:.1f} N m: teeth re-found {maxpen_nl * 1000:.3f} um inside each "
+                                 f"other, beyond the {REDETECTED_LIMIT * 1000:g} um a solve may leave")
         twists.append(level.twist)
         kinds = np.array([i[0] for i in level.pair_ids])
         geo_mask = kinds != "ball"
