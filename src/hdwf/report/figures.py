@@ -43,9 +43,9 @@ def stamped(provenance: dict | None):
 
 
 def _save(fig, path):
-    meta = dict(_PNG_META)
-    if _provenance.get() is not None:
-        meta[PROVENANCE_TEXT_KEY] = _provenance.get()
+    meta, provenance = dict(_PNG_META), _provenance.get()
+    if provenance is not None:
+        meta[PROVENANCE_TEXT_KEY] = provenance
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=150, format="png", metadata=meta, bbox_inches="tight")
     plt.close(fig)
@@ -280,6 +280,9 @@ def deformed_figure(mesh, fields: dict, material: Material, title: str, path, ha
     # A half model (180° point symmetry) holds angles 0..π; the rest is its image under p -> -p, u -> -u.
     images = (1.0, -1.0) if getattr(mesh, "symmetry", "full") == "half" else (1.0,)
     for name, body in mesh.bodies.items():
+        # the image p -> -p, u -> -u has the same strain: one stress field serves both
+        added = (von_mises_stress(body.mesh, plus[name] - wg[name], material.E, material.nu)
+                 if name in ("fs", "cs") else None)
         for sgn in images:
             p, t = sgn * body.mesh.p, body.mesh.t
             x = p + magnify * sgn * plus[name]
@@ -287,8 +290,7 @@ def deformed_figure(mesh, fields: dict, material: Material, title: str, path, ha
             keep = ((corners[0].max(axis=0) > xlim[0]) & (corners[0].min(axis=0) < xlim[1])
                     & (corners[1].max(axis=0) > -ymax) & (corners[1].min(axis=0) < ymax))
             tri = x[:, t[:, keep]].transpose(2, 1, 0)  # (n, 3, 2)
-            if name in ("fs", "cs"):
-                added = von_mises_stress(body.mesh, plus[name] - wg[name], material.E, material.nu)
+            if added is not None:
                 polys.append(tri)
                 values.append(added[keep])
             else:

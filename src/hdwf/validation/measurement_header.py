@@ -42,8 +42,8 @@ def header_problems(cols: list[str]) -> tuple[str | None, list[tuple]]:
     columns that look meant for the loader but would be ignored (``(row, field, value, message)``,
     as ``MeasurementError`` takes them; row is None)."""
     cols = [str(c) for c in cols]
-    if len(cols) == 1 and any(sep in cols[0] for sep in (";", "\t", "|")):
-        sep = next(sep for sep in (";", "\t", "|") if sep in cols[0])
+    sep = next((sep for sep in (";", "\t", "|") if sep in cols[0]), None) if len(cols) == 1 else None
+    if sep:
         return None, [(None, None, None, f"the header is one column, {cols[0][:60]!r}: the columns are separated by "
                                          f"{sep!r}, not commas; save the file as comma-separated CSV")]
     problems = []

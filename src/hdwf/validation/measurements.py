@@ -390,9 +390,10 @@ def _drive_problems(data: pd.DataFrame, unit: str) -> list[tuple]:
     for sid, rows in data.groupby("specimen_id", sort=False):
         first = rows.index[0]
         # ids outside the pattern are refused below; within it (ASCII) case is all that can differ
-        other = by_folded_case.setdefault(sid.lower(), (sid, first)) if re.fullmatch(SPECIMEN_ID_PATTERN, sid) else (sid,)
-        if other[0] != sid:
-            problems.append((first + 1, "specimen_id", sid, f"differs from specimen '{other[0]}' (row {other[1] + 1}) "
+        other, other_row = (by_folded_case.setdefault(sid.lower(), (sid, first))
+                            if re.fullmatch(SPECIMEN_ID_PATTERN, sid) else (sid, first))
+        if other != sid:
+            problems.append((first + 1, "specimen_id", sid, f"differs from specimen '{other}' (row {other_row + 1}) "
                                                             "only in case; a campaign names files after ids, and macOS "
                                                             "and Windows file systems do not tell them apart"))
         if rows["unit"].iloc[0] in UNITS and rows["unit"].iloc[0] != unit:  # an unknown drive is named already
