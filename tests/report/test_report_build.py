@@ -321,6 +321,18 @@ def test_ladder_is_held_against_the_bearing_rating():
     assert _bearing_sentence(lad.drop(columns=["specimens_checked"])) == ""
 
 
+def test_ladder_gives_the_solvers_own_contact_check():
+    """The largest penetration re-found from scratch at ±T over the rungs, with the rung it is on and
+    the limit beyond which a solve fails; a ladder from before the check, or with no solve, says nothing."""
+    import pandas as pd
+    from hdwf.report.validation_part import _contact_check_sentence
+    lad = pd.DataFrame({"rung": [0, 1, 2], "max_penetration_redetected_um": [0.012, 0.0481, float("nan")]})
+    said = _contact_check_sentence(lad)
+    assert "at most 0.048 µm" in said and "(rung 1;" in said and "beyond 0.5 µm" in said
+    assert _contact_check_sentence(lad.assign(max_penetration_redetected_um=float("nan"))) == ""
+    assert _contact_check_sentence(lad.drop(columns="max_penetration_redetected_um")) == ""
+
+
 def test_ladder_names_the_rungs_whose_solve_failed():
     """A rung with a failed specimen has no error in the table (``ladder_table``); the text says which
     rung and specimen, and says nothing when every rung solved or the ladder predates the column."""

@@ -8,26 +8,27 @@ import pandas as pd
 import pytest
 
 from hdwf.fe.hertz import ISO76_BALL_PRESSURE_MPA
-from hdwf.validation.ladder import bearing_check, ladder_table, ladder_variants
+from hdwf.validation.ladder import bearing_check, ladder_table, ladder_variants, largest_redetected_penetration
 from hdwf.validation.measurements import Measurements
 from hdwf.validation.variants import TABLE_COLUMNS, variant_key
 
 PRELOAD = {"preload": {"interference_m": 0.2}}
 
 
-def _rows(sid, effects, lost_motion, pressure):
+def _rows(sid, effects, lost_motion, pressure, penetration_um=0.01):
     """One variant's test 0 -> +T -> 0 -> -T -> 0 whose lost motion is ``lost_motion``."""
     tw = np.array([0.0, 0.5, 0.1, 0.5 - lost_motion, 0.0])
     return pd.DataFrame({"specimen_id": sid, "variant": variant_key(effects), "step": np.arange(5),
                          "torque_Nm": [0.0, 0.96, 0.0, -0.96, 0.0], "twist_arcmin": tw, "status": "ok",
-                         "ball_pressure_max_MPa": pressure})[TABLE_COLUMNS]
+                         "ball_pressure_max_MPa": pressure,
+                         "max_penetration_redetected_um": penetration_um})[TABLE_COLUMNS]
 
 
 def _campaign():
     meas = pd.DataFrame({"specimen_id": ["s1", "s2"], "lost_motion_arcmin": [1.0, 2.0]})
     m = Measurements(Path("lm.csv"), "lost_motion", meas, meas.assign(unit="hd42"))
     table = pd.concat([_rows("s1", {}, 3.0, 900.0), _rows("s2", {}, 4.0, 950.0),
-                       _rows("s1", PRELOAD, 1.1, 3000.0), _rows("s2", PRELOAD, 1.9, 5000.0)],
+                       _rows("s1", PRELOAD, 1.1, 3000.0, 0.03), _rows("s2", PRELOAD, 1.9, 5000.0, 0.2)],
                       ignore_index=True)
     return m, table
 
@@ -58,6 +59,20 @@ def test_a_table_without_pressures_checks_nothing():
     assert np.isnan(got["ball_pressure_max_MPa"]) and got["specimens_checked"] == 0
     failed = table.assign(ball_pressure_max_MPa=np.where(table["specimen_id"] == "s2", np.nan, 3000.0))
     assert bearing_check(failed, variant_key(PRELOAD))["specimens_checked"] == 1
+
+
+def test_each_rung_carries_the_solvers_own_contact_check():
+    """The largest penetration re-found from scratch at +-T over a rung's specimens: 0.01 um on the
+    bare rung, 0.2 um (s2) with the preload; a failed solve's NaN is not taken for a number, and a
+    table from before the column existed gives NaN, not 0."""
+    meas, table = _campaign()
+    lad = ladder_table(meas, table, ladder_variants({}, [("preload", {"interference_m": 0.2})]))
+    assert lad["max_penetration_redetected_um"].tolist() == pytest.approx([0.01, 0.2])
+    failed = (table["specimen_id"] == "s2") & (table["variant"] == variant_key(PRELOAD))
+    table.loc[failed, "max_penetration_redetected_um"] = np.nan
+    assert largest_redetected_penetration(table, variant_key(PRELOAD)) == pytest.approx(0.03)
+    assert np.isnan(largest_redetected_penetration(table.drop(columns="max_penetration_redetected_um"),
+                                                   variant_key(PRELOAD)))
 
 
 def test_a_rung_whose_solve_failed_for_a_specimen_has_no_error():

@@ -13,6 +13,7 @@ import pandas as pd
 from hdwf.common.io import read_json
 from hdwf.drive.design import MeshSettings
 from hdwf.fe.hertz import ISO76_BALL_PRESSURE_MPA
+from hdwf.fe.relinearise import REDETECTED_LIMIT
 from hdwf.report.artefacts import CampaignArtefacts
 from hdwf.report.document import UNIT_NAMES, Document, fmt, lit
 from hdwf.validation.effects import get as get_effect
@@ -326,6 +327,16 @@ def _failed_rungs_sentence(ladder: pd.DataFrame) -> str:
     return f"*No error is given where a rung's solve failed:* {'; '.join(failed)} (see their tables' status).{basis}"
 
 
+def _contact_check_sentence(ladder: pd.DataFrame) -> str:
+    """The solver's own check on every rung's solves: tooth pairs re-found from scratch at ±T."""
+    if "max_penetration_redetected_um" not in ladder or ladder["max_penetration_redetected_um"].isna().all():
+        return ""
+    worst = ladder.loc[ladder["max_penetration_redetected_um"].idxmax()]
+    return (f"The solver's own check: the tooth pairs, re-found from scratch at ±T, sink at most "
+            f"{fmt(worst['max_penetration_redetected_um'], 3)} µm into each other over every rung's solves "
+            f"(rung {int(worst['rung'])}; a solve fails beyond {REDETECTED_LIMIT * 1000:g} µm).")
+
+
 def _bearing_sentence(ladder: pd.DataFrame) -> str:
     """The rungs held against the wave-generator bearing's static rating (ISO 76, 4200 MPa)."""
     if "specimens_checked" not in ladder or not ladder["specimens_checked"].gt(0).any():
@@ -383,6 +394,9 @@ def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2,
     failed = _failed_rungs_sentence(ladder)
     if failed:
         doc.text(failed)
+    contact = _contact_check_sentence(ladder)
+    if contact:
+        doc.text(contact)
     bearing = _bearing_sentence(ladder)
     if bearing:
         doc.text(bearing)

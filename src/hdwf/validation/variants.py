@@ -52,7 +52,8 @@ if TYPE_CHECKING:   # a specimen's job (one specimen, an Arrow table out) starts
     import pandas as pd
 
 BASELINE = "baseline"
-TABLE_COLUMNS = ["specimen_id", "variant", "step", "torque_Nm", "twist_arcmin", "status", "ball_pressure_max_MPa"]
+TABLE_COLUMNS = ["specimen_id", "variant", "step", "torque_Nm", "twist_arcmin", "status", "ball_pressure_max_MPa",
+                 "max_penetration_redetected_um"]
 # ball_pressure_max_MPa: the most loaded wave-generator ball's raceway pressure at the mount (the
 # same for every step of a variant), to hold a found effect against the bearing's rating
 # the thread counts of the BLAS libraries numpy and scipy may be linked against
@@ -214,7 +215,8 @@ def solve_specimen(setup: SolveSetup, specimen: Mapping, variants: list[dict]) -
         frames.append(arrow_table(dict(zip(TABLE_COLUMNS, (
             [specimen["specimen_id"]] * n, [variant_key(eff)] * n, np.asarray(step, dtype="int64"),
             np.asarray(torque, float), np.asarray(tw, float), ["ok" if ok else f"failed: {res.reason}"] * n,
-            np.full(n, float(res.max_ball_pressure_MPa) if ok else np.nan))))))
+            np.full(n, float(res.max_ball_pressure_MPa) if ok else np.nan),
+            np.full(n, float(res.max_penetration_redetected_um) if ok else np.nan))))))
     return pa.concat_tables(frames)
 
 
