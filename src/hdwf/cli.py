@@ -13,8 +13,8 @@ from pathlib import Path
 
 from hdwf import __version__
 from hdwf.common.errors import ConfigError, InputError, SolveFailed
-from hdwf.common.io import atomic_path
-from hdwf.common.provenance import config_hash, provenance
+from hdwf.common.io import atomic_path, write_parquet
+from hdwf.common.provenance import config_hash, provenance, tool_provenance
 from hdwf.config import SCHEMA_PATH, blame, fe_option_bounds, load_config
 from hdwf.stages.validation import campaign_plan, campaign_specimens
 from hdwf.study.paper import PAPER_TABLES, paper_measurements
@@ -199,8 +199,12 @@ def _synth(args) -> int:
     with _new_output(out, args) as tmp:
         if out.suffix.lower() == ".csv":
             data.to_csv(tmp, index=False, float_format="%.9g")
-        else:
-            data.to_parquet(tmp, index=False)
+        else:   # Parquet carries what made it; a CSV stays plain, as bench files are
+            settings = {"unit": args.unit, "designs": args.designs, "seed": args.seed,
+                        "noise_arcmin": args.noise_arcmin, "effects": effects,
+                        "ranges": {k: list(v) for k, v in ranges.items()},
+                        "mesh": _solve_setup(args).mesh, "steps_per_ramp": args.steps_per_ramp}
+            write_parquet(data, tmp, provenance=tool_provenance(settings), meta={"hdwf_synth": settings})
     hidden = ", ".join(f"{n}:{p}={v:g}" for n, ps in effects.items() for p, v in ps.items()) or "none"
     batch = format_ranges(ranges)
     print(f"{out}: {args.designs} specimens of {args.unit}{batch}, {len(data)} points; effects: {hidden}; "

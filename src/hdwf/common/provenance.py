@@ -62,3 +62,9 @@ def provenance(config: dict, repo_dir: str | Path = ".") -> dict:
         "python": platform.python_version(),
         "packages": package_versions(),
     }
+
+
+def tool_provenance(settings: dict) -> dict:
+    """``provenance`` of a file a command writes outside any project (``hdwf synth``): its
+    settings stand for the config, and the commit is that of the checkout ``hdwf`` runs from."""
+    return provenance(settings, _LIBRARY_ROOT)
