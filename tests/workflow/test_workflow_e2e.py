@@ -208,6 +208,8 @@ def test_validation_campaign_chain(tmp_path):
     ladder = pd.read_parquet(ws / target)
     assert list(ladder["model"]) == ["baseline", "with thermal"]
     assert ladder["rmse_arcmin"].iloc[1] < 0.5 * ladder["rmse_arcmin"].iloc[0]
+    # every rung's solves passed the solver's own check, which fails a solve beyond 0.5 um
+    assert ladder["max_penetration_redetected_um"].between(0.0, 0.5).all(), ladder
 
     # a measured value changes: the diagnosis re-runs, the specimens' solves do not
     data_file = ws / "data/validation/tiny.csv"
@@ -229,5 +231,6 @@ def test_validation_campaign_chain(tmp_path):
     assert run.returncode != 0
     # row 1 is the first data row
     assert "tiny.csv" in run.stderr and "row 7" in run.stderr and "twist_arcmin" in run.stderr, run.stderr[-2000:]
+    assert "MeasurementError in campaign 'tiny'" in run.stderr and "Traceback" not in run.stderr, run.stderr[-2000:]
     after = {p: p.read_bytes() for p in (ws / "results/validation").rglob("*") if p.is_file()}
     assert after == before

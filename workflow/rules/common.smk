@@ -2,10 +2,12 @@
 # which files each rule reads.  Rule files hold rules only (snakemake --lint).
 
 import dataclasses
+import sys
 
 from hdwf.config import design_ids as config_design_ids
 from hdwf.stages.validation import campaign_plan, campaign_specimens, specimen_record
 from hdwf.study.paper import FEA_TABLES, PAPER_TABLES
+from hdwf.validation.measurements import MeasurementError
 
 STUDIES = config["studies"]
 PAPER_STUDIES = [s for s, v in STUDIES.items() if v["source"] == "paper"]
@@ -74,9 +76,18 @@ _SPECIMENS = {}
 
 
 def specimens_of(campaign):
-    """The campaign's specimens, read (and checked) once from its measurement file."""
+    """The campaign's specimens, read (and checked) once from its measurement file.
+
+    A bad file stops the run with the loader's message alone: raised from an input function, an
+    exception would come wrapped in Snakemake's traceback (SystemExit is let through unwrapped)."""
     if campaign not in _SPECIMENS:
-        _SPECIMENS[campaign] = campaign_specimens(CAMPAIGNS[campaign])
+        try:
+            _SPECIMENS[campaign] = campaign_specimens(CAMPAIGNS[campaign])
+        except MeasurementError as exc:
+            print(f"MeasurementError in campaign '{campaign}' (validation.{campaign}.measurements): {exc}\n"
+                  f"Nothing was run. Check the file with: hdwf check-measurements {CAMPAIGNS[campaign].measurements} "
+                  f"--unit {CAMPAIGNS[campaign].unit}", file=sys.stderr)
+            raise SystemExit(1)
     return _SPECIMENS[campaign]
 
 
