@@ -333,7 +333,7 @@ def _contact_check_sentence(ladder: pd.DataFrame) -> str:
         return ""
     worst = ladder.loc[ladder["max_penetration_redetected_um"].idxmax()]
     return (f"The solver's own check: the tooth pairs, re-found from scratch at ±T, sink at most "
-            f"{fmt(worst['max_penetration_redetected_um'], 3)} µm into each other over every rung's solves "
+            f"{fmt(worst['max_penetration_redetected_um'], 4)} µm into each other over every rung's solves "
             f"(rung {int(worst['rung'])}; a solve fails beyond {REDETECTED_LIMIT * 1000:g} µm).")
 
 
