@@ -396,7 +396,7 @@ def geometric_backlash_arcmin(g: DriveGeometry, radial_shortfall_mm: float = 0.0
 # Builder
 # --------------------------------------------------------------------------------------
 def drive_geometry(unit: str, d_mm: float, D_mm: float, Gr_mm: float, rFS_mm: float,
-                   rCS_mm: float, interference_m: float = 0.0,
+                   rCS_mm: float, *, interference_m: float = 0.0,
                    tip_relief: float = 0.0, deflection_coeff: float = 1.0,
                    addendum_frac: float | None = None, tip_round_m: float = 0.0,
                    offset_direction: str = "normal") -> DriveGeometry:
