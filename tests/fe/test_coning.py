@@ -35,14 +35,16 @@ def _parallel(K1, K2, b):
     return torque_at
 
 
-@pytest.mark.parametrize("T", [960.0, -960.0, 3000.0])
+@pytest.mark.parametrize("T", [50.0, -50.0, 960.0, -960.0, 3000.0])
 def test_twist_at_torque_is_exact_on_piecewise_linear_slices(T):
     """At T the common twist solves (K1 theta + K2 max(0, theta - b)) / 2 = T (one side or the
-    other of the second slice's backlash, by the torque)."""
+    other of the second slice's backlash, by the torque: +-50 N mm stays inside it, 2T/K1 = 0.17
+    arcmin against b = 0.3; +-960 and 3000 N mm go beyond)."""
     K1, K2, b = 2.0e6, 3.0e6, 0.3 * ARCMIN
     theta, evaluations = twist_at_torque(_parallel(K1, K2, b), T, coning.FIRST_STEP)
     th1 = 2 * abs(T) / K1                      # the stiff slice alone
     expect = th1 if th1 <= b else (2 * abs(T) + K2 * b) / (K1 + K2)
+    assert (th1 <= b) == (abs(T) < 100.0)        # both branches are tested
     assert theta == pytest.approx(np.sign(T) * expect, abs=coning.THETA_TOL)
     assert evaluations < coning.MAX_EVALUATIONS
 

@@ -43,5 +43,7 @@ def test_closest_segment_gap_is_negative_when_sunk_in_at_a_concave_vertex():
     pts = np.array([[0.0, -0.03], [0.0, 0.3], [-0.5, 0.2]]).T
     gap, seg, _ = closest_segments(pts, xa, xb, nrm)
     assert gap[0] == pytest.approx(-0.03)                          # sunk in at the vertex
-    assert gap[1] > 0                                               # above it: outside
+    # above it: outside, measured along either segment's normal (it projects inside both), not
+    # to the vertex (0.3): the concave-vertex rule is for points behind both segments only
+    assert gap[1] == pytest.approx(0.3 * 2 / math.sqrt(5))
     assert gap[2] == pytest.approx((0.2 - 0.25) * 2 / math.sqrt(5)) and seg[2] == 0

@@ -198,8 +198,9 @@ def test_full_fields_reproduce_the_contact_solution(monkeypatch, symmetry):
     # wg, the check of the teeth outside the zones at the mount, plus
     assert set(r.fields) == {"wg", "plus"} and len(diffs) == 3
     assert max(diffs) < 1e-3 * TOL_GAP  # mm
-    # the mounted wave generator pushes the FS out at the major axis by about w0 = m
-    assert r.wg_deflection_um > 0.5 * g.w0 * 1000
+    # the cam is sized so that the rigid nominal bearing pushes the FS out at the major axis by
+    # w0 = m (test_cam_gives_w0_equal_module); the elastic balls and rings take a little of it
+    assert r.wg_deflection_um == pytest.approx(1000 * g.w0, rel=0.03)
 
 
 # ------------------------------------------------------------------ half model (180 deg)

@@ -75,8 +75,16 @@ def test_paper_indices_reproduced(paper_dir, unit):
     # rFS and rCS carry the two largest total effects, as the paper finds.
     assert set(exact["ST"].nlargest(2).index) == {"rFS", "rCS"}
     pub = load_published(paper_dir)
+    # The paper's indices are sampling estimates over bounds it does not state; ours are exact over
+    # the span of its designs. Every index agrees within 0.025 (HD 120's smallest published, 0.052 for
+    # G_r, then within half its value), but HD 42's S_T of r_CS: the published 0.5513 lies 0.060 above
+    # the exact 0.4913 (docs/results.md gives that gap as the replication's largest).
     for r in pub[(pub.unit == unit) & pub.statistic.str.startswith("sobol")].itertuples():
-        assert abs(exact.loc[r.parameter, r.statistic.split("_")[1]] - r.value) < 0.07, (r.parameter, r.statistic)
+        diff = exact.loc[r.parameter, r.statistic.split("_")[1]] - r.value
+        if (unit, r.parameter, r.statistic) == ("hd42", "rCS", "sobol_ST"):
+            assert diff == pytest.approx(-0.060, abs=1e-3)
+        else:
+            assert abs(diff) < 0.025, (r.parameter, r.statistic, diff)
 
 
 def test_convergence_stops_at_tolerance_and_reports_failure():

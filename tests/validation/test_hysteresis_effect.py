@@ -204,9 +204,14 @@ def _twist(curves, effects):
 
 @pytest.mark.slow
 def test_grid_solves_never_fail_inside_the_bounds(table):
-    *_, curves = table
+    """Every grid value, the bounds included, gives the whole test 0 -> +T -> 0 -> -T -> 0
+    (4 x STEPS + 1 points, as far to -T as to +T), solved."""
+    _, values, _, curves = table
+    assert len(curves) == len(values) + 2        # the campaign model, each value, with the cup spring
     for key, c in curves.items():
         assert (c["status"] == "ok").all(), (key, c["status"].unique())
+        assert c["step"].tolist() == list(range(4 * STEPS + 1)), key
+        assert c["torque_Nm"].max() == pytest.approx(-c["torque_Nm"].min()) and c["torque_Nm"].max() > 0
         assert np.isfinite(c["twist_arcmin"]).all()
 
 
