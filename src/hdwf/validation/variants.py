@@ -55,7 +55,8 @@ BASELINE = "baseline"
 TABLE_COLUMNS = ["specimen_id", "variant", "step", "torque_Nm", "twist_arcmin", "status", "ball_pressure_max_MPa",
                  "max_penetration_redetected_um"]
 # ball_pressure_max_MPa: the most loaded wave-generator ball's raceway pressure at the mount (the
-# same for every step of a variant), to hold a found effect against the bearing's rating
+# same for every step of a variant), to hold a found effect against the bearing's rating;
+# max_penetration_redetected_um: the solver's check from scratch at +-T, as the studies' rows keep it
 # the thread counts of the BLAS libraries numpy and scipy may be linked against
 _BLAS_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
