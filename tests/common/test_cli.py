@@ -84,6 +84,9 @@ def test_synth_shows_progress_and_writes_the_test_cycle(tmp_path, capsys):
     data = pd.read_csv(out)
     # 0 -> +T -> 0 -> -T -> 0 at 2 steps per ramp: 4 x 2 + 1 points per specimen
     assert data.groupby("specimen_id").size().tolist() == [9, 9]
+    # HD 42's test torque is 4 % of its rated 24 N m (paper Table 1): 0.96 N m, two steps each way
+    first = data[data["specimen_id"] == data["specimen_id"].iloc[0]]
+    assert first["torque_Nm"].tolist() == pytest.approx([0, 0.48, 0.96, 0.48, 0, -0.48, -0.96, -0.48, 0])
     # noise-free data state no uncertainty (zero is refused), so the file loads as it is
     assert "u_twist_arcmin" not in data and len(load_measurements(out).specimens) == 2
 
