@@ -126,7 +126,8 @@ def test_study_report_stage_writes_the_pdf(named_inputs, tmp_path):
     assert "hdwf study 'paper'" in text and "Replication of the paper’s published statistics." in text
     # the numbers typeset are the artefacts': Spearman of r_FS recomputed from Table 4 (the paper's
     # 0.6758) and our quadratic surrogate's R² (0.9892, docs/results.md)
-    assert "0.6758" in text and "0.9892" in text
+    # (the paper's published 0.6758 is printed beside ours, so ours makes it appear twice)
+    assert text.count("0.6758") >= 2 and "0.9892" in text
 
 
 def test_full_report_stage_with_a_paper_study_only(named_inputs, tmp_path):
@@ -136,7 +137,7 @@ def test_full_report_stage_with_a_paper_study_only(named_inputs, tmp_path):
     assert pdf.read_bytes()[:5] == b"%PDF-"
     text = _pdf_text(pdf)
     assert "Part I — the paper's FEA tables (study 'paper')" in text and "Part II — our FE model" not in text
-    assert "0.6758" in text and "0.9892" in text     # as in the study's own report
+    assert text.count("0.6758") >= 2 and "0.9892" in text     # as in the study's own report
 
 
 def test_knee_section_fits_both_models(named_inputs, tmp_path):
@@ -276,6 +277,18 @@ def test_ball_load_sentence_holds_the_mount_against_iso_76():
     assert _ball_load(pd.DataFrame({"lost_motion_arcmin": [1.0]})) == ""
 
 
+def test_study_solve_summary_gives_the_check_from_scratch_only_where_made():
+    """The largest penetration re-found at ±T over a study's designs; designs solved without the
+    check (coned cups: NaN) are counted, failed ones are not; no check at all says nothing."""
+    import pandas as pd
+    from hdwf.report.fe_part import _redetected
+    lm = pd.DataFrame({"max_penetration_redetected_um": [0.01, 0.047, float("nan"), float("nan")],
+                       "status": ["ok", "ok", "ok", "failed: x"]})
+    assert _redetected(lm) == ", re-found from scratch at ±T 0.0470 µm (not checked on 1 solved design)"
+    assert _redetected(lm.iloc[:2]) == ", re-found from scratch at ±T 0.0470 µm"
+    assert _redetected(lm.iloc[2:]) == "" and _redetected(lm.drop(columns="max_penetration_redetected_um")) == ""
+
+
 def test_convergence_table_marks_changes_below_the_contact_tolerance():
     """A design that misses 2 % by less than the solver resolves is marked *res.*, counted apart
     from the converged ones and from the real misses; an older table (no resolution) says
@@ -327,12 +340,21 @@ def test_ladder_is_held_against_the_bearing_rating():
 
 def test_ladder_gives_the_solvers_own_contact_check():
     """The largest penetration re-found from scratch at ±T over the rungs, with the rung it is on and
-    the limit beyond which a solve fails; a ladder from before the check, or with no solve, says nothing."""
+    the limit beyond which a solve fails; "every rung" only when every solved specimen of every rung
+    was checked, else the rungs it was not made for are named; a ladder from before the check says
+    nothing."""
     import pandas as pd
     from hdwf.report.validation_part import _contact_check_sentence
-    lad = pd.DataFrame({"rung": [0, 1, 2], "max_penetration_redetected_um": [0.012, 0.0481, float("nan")]})
+    lad = pd.DataFrame({"rung": [0, 1, 2], "model": ["baseline", "with preload", "with preload, coning"],
+                        "max_penetration_redetected_um": [0.012, 0.0481, float("nan")],
+                        "specimens_contact_unchecked": [0, 0, 0]})
     said = _contact_check_sentence(lad)
-    assert "at most 0.0481 µm" in said and "(rung 1;" in said and "beyond 0.5 µm" in said
+    assert "at most 0.0481 µm" in said and "over every rung's solves (rung 1;" in said and "beyond 0.5 µm" in said
+    said = _contact_check_sentence(lad.assign(specimens_contact_unchecked=[27, 0, 3]))
+    assert "over the solves that made the check (rung 1;" in said and "every rung" not in said
+    assert "*Not made* for rung 0 (baseline) on 27 specimens; rung 2 (with preload, coning) on 3 specimens" in said
+    none = lad.assign(max_penetration_redetected_um=float("nan"), specimens_contact_unchecked=[27, 27, 27])
+    assert _contact_check_sentence(none).startswith("The solver's check from scratch at ±T was not made for rung 0")
     assert _contact_check_sentence(lad.assign(max_penetration_redetected_um=float("nan"))) == ""
     assert _contact_check_sentence(lad.drop(columns="max_penetration_redetected_um")) == ""
 

@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 
 from hdwf.fe.hertz import ISO76_BALL_PRESSURE_MPA
-from hdwf.validation.ladder import bearing_check, ladder_table, ladder_variants, largest_redetected_penetration
+from hdwf.validation.ladder import bearing_check, contact_check, ladder_table, ladder_variants
 from hdwf.validation.measurements import Measurements
 from hdwf.validation.variants import TABLE_COLUMNS, variant_key
 
@@ -63,16 +63,22 @@ def test_a_table_without_pressures_checks_nothing():
 
 def test_each_rung_carries_the_solvers_own_contact_check():
     """The largest penetration re-found from scratch at +-T over a rung's specimens: 0.01 um on the
-    bare rung, 0.2 um (s2) with the preload; a failed solve's NaN is not taken for a number, and a
-    table from before the column existed gives NaN, not 0."""
+    bare rung, 0.2 um (s2) with the preload, every solved specimen checked. A specimen without the
+    value (a table from before the column, a coned cup) is counted as unchecked, not read as 0 or
+    as covered by the others; a failed solve is neither."""
     meas, table = _campaign()
     lad = ladder_table(meas, table, ladder_variants({}, [("preload", {"interference_m": 0.2})]))
     assert lad["max_penetration_redetected_um"].tolist() == pytest.approx([0.01, 0.2])
-    failed = (table["specimen_id"] == "s2") & (table["variant"] == variant_key(PRELOAD))
-    table.loc[failed, "max_penetration_redetected_um"] = np.nan
-    assert largest_redetected_penetration(table, variant_key(PRELOAD)) == pytest.approx(0.03)
-    assert np.isnan(largest_redetected_penetration(table.drop(columns="max_penetration_redetected_um"),
-                                                   variant_key(PRELOAD)))
+    assert lad["specimens_contact_unchecked"].tolist() == [0, 0]
+    key = variant_key(PRELOAD)
+    s2 = (table["specimen_id"] == "s2") & (table["variant"] == key)
+    unchecked = table.assign(max_penetration_redetected_um=np.where(s2, np.nan, table["max_penetration_redetected_um"]))
+    assert contact_check(unchecked, key) == {"max_penetration_redetected_um": pytest.approx(0.03),
+                                            "specimens_contact_unchecked": 1}
+    failed = unchecked.assign(status=np.where(s2, "failed: no contact pair", unchecked["status"]))
+    assert contact_check(failed, key)["specimens_contact_unchecked"] == 0
+    old = contact_check(table.drop(columns="max_penetration_redetected_um"), key)
+    assert np.isnan(old["max_penetration_redetected_um"]) and old["specimens_contact_unchecked"] == 2
 
 
 def test_a_rung_whose_solve_failed_for_a_specimen_has_no_error():

@@ -99,7 +99,7 @@ class TorqueTest:
     """Stage 2 solved: rim twists (rad) and the checks of the contact solution."""
     twists: np.ndarray
     max_penetration: float             # mm, over every level (balls excluded)
-    max_penetration_redetected: float  # mm, tooth pairs re-found at +-T
+    max_penetration_redetected: float  # mm, tooth pairs re-found at +-T (NaN: not checked)
     teeth_in_contact: int              # at +T
     loaded_arc_deg: float              # at +T: the loaded tooth farthest from a major axis
     fields: dict | None                # displacement fields (keep_fields)
@@ -231,7 +231,9 @@ def lost_motion_result(model: LostMotionModel, changes: ModelChanges, frac: np.n
     kp = int(np.argmin(np.abs(frac - 1.0)))
     km = int(np.argmin(np.abs(frac + 1.0)))
     phi_p, phi_m = float(tw[kp]), float(-tw[km])
-    maxpen_nl = test.max_penetration_redetected
+    # NaN where the check was not made (a coned cup's slices keep their settled gaps)
+    redetected_um = max(0.0, test.max_penetration_redetected) * 1000.0
+    redetected_um = redetected_um if math.isfinite(test.max_penetration_redetected) else float("nan")
     mount = mounted.solution
     ball_N = float(mount.normal_force[[k == "ball" for k, _ in mount.pair_ids]].max(initial=0.0))
     return LostMotionResult(
@@ -241,12 +243,13 @@ def lost_motion_result(model: LostMotionModel, changes: ModelChanges, frac: np.n
         max_penetration_um=max(0.0, test.max_penetration) * 1000.0, iterations=model.iterations,
         status="ok", reason="", solve_s=time.perf_counter() - t0,
         factorize_s=model.factorize_s, n_dofs=model.n_dofs, wg_deflection_um=mounted.deflection_um,
-        max_penetration_redetected_um=max(0.0, maxpen_nl) * 1000.0,
+        max_penetration_redetected_um=redetected_um,
         overlap_outside_zones_um=mounted.outside_overlap_um, loaded_arc_deg=test.loaded_arc_deg,
         max_ball_load_N=ball_N, max_ball_pressure_MPa=ball_max_pressure(model.geometry, ball_N, model.material.E),
         notes=(f"zero-torque steps at {ZERO_TORQUE_BIAS:g} T_test towards the last load; "
                f"tooth penetration re-detected at the deformed state at +-T: "
-               f"{max(0.0, maxpen_nl) * 1000:.4f} um; teeth outside the solved zones overlap by "
+               + (f"{redetected_um:.4f} um" if math.isfinite(redetected_um) else "not checked")
+               + "; teeth outside the solved zones overlap by "
                f"{mounted.outside_overlap_um:.2f} um at the mount" + _preload_note(mounted.preload)),
         fields=test.fields)
 

@@ -328,13 +328,24 @@ def _failed_rungs_sentence(ladder: pd.DataFrame) -> str:
 
 
 def _contact_check_sentence(ladder: pd.DataFrame) -> str:
-    """The solver's own check on every rung's solves: tooth pairs re-found from scratch at ±T."""
-    if "max_penetration_redetected_um" not in ladder or ladder["max_penetration_redetected_um"].isna().all():
+    """The solver's own check on the rungs' solves (tooth pairs re-found from scratch at ±T), and
+    the rungs with solves it was not made for."""
+    if "max_penetration_redetected_um" not in ladder:
         return ""
+    unchecked = (ladder[ladder["specimens_contact_unchecked"] > 0] if "specimens_contact_unchecked" in ladder
+                 else ladder.iloc[:0])
+    missing = ("; ".join(f"rung {int(r['rung'])} ({lit(r['model'])}) on {int(r['specimens_contact_unchecked'])} "
+                         f"specimen{'s' if r['specimens_contact_unchecked'] > 1 else ''}"
+                         for r in unchecked.to_dict("records")))
+    why = ("tables solved before the check was recorded, or a coned cup, whose slices keep their settled gaps")
+    if ladder["max_penetration_redetected_um"].isna().all():
+        return f"The solver's check from scratch at ±T was not made for {missing} ({why})." if missing else ""
     worst = ladder.loc[ladder["max_penetration_redetected_um"].idxmax()]
     return (f"The solver's own check: the tooth pairs, re-found from scratch at ±T, sink at most "
-            f"{fmt(worst['max_penetration_redetected_um'], 4)} µm into each other over every rung's solves "
-            f"(rung {int(worst['rung'])}; a solve fails beyond {REDETECTED_LIMIT * 1000:g} µm).")
+            f"{fmt(worst['max_penetration_redetected_um'], 4)} µm into each other over "
+            + ("every rung's solves" if not missing else "the solves that made the check")
+            + f" (rung {int(worst['rung'])}; a solve fails beyond {REDETECTED_LIMIT * 1000:g} µm)."
+            + (f" *Not made* for {missing} ({why})." if missing else ""))
 
 
 def _bearing_sentence(ladder: pd.DataFrame) -> str:

@@ -65,8 +65,8 @@ def ladder_table(meas: Measurements, table: pd.DataFrame, rungs: list[tuple[str,
         ``delta_bic_against_rung``; -1 when none did), ``solved``,
         ``failed_specimens`` (comma-separated; empty when every solve succeeded), and the bearing
         check of the rung's model (``bearing_check``): the largest ball pressure at the mount over
-        the specimens and how many exceed ISO 76's static rating; ``max_penetration_redetected_um``,
-        the solver's own check (``largest_redetected_penetration``). A rung whose solve failed for
+        the specimens and how many exceed ISO 76's static rating; the solver's own check
+        (``contact_check``). A rung whose solve failed for
         any specimen has no error figures (NaN): scored on the specimens left, it would look
         better than a rung that solved them all.
     """
@@ -83,8 +83,7 @@ def ladder_table(meas: Measurements, table: pd.DataFrame, rungs: list[tuple[str,
                      "bias_arcmin": float(np.mean(E)), "max_abs_arcmin": float(np.max(np.abs(E))),
                      "bic": bic(float(np.sum(E ** 2)), len(D), n_par), "solved": bool(solved.all()),
                      "failed_specimens": ", ".join(sorted(set(obs["specimen_id"].to_numpy()[~solved]))),
-                     **bearing_check(table, variant_key(eff)),
-                     "max_penetration_redetected_um": largest_redetected_penetration(table, variant_key(eff))})
+                     **bearing_check(table, variant_key(eff)), **contact_check(table, variant_key(eff))})
     ladder = pd.DataFrame(rows)
     # against the first rung that has a BIC: a failed baseline leaves the later rungs comparable
     finite = ladder["bic"].notna()
@@ -112,15 +111,21 @@ def bearing_check(table: pd.DataFrame, key: str) -> dict:
             "specimens_checked": int(len(per))}
 
 
-def largest_redetected_penetration(table: pd.DataFrame, key: str) -> float:
-    """How far the tooth pairs, re-found from scratch at +-T, sink into each other under variant
-    ``key``: the largest over the specimens whose solve succeeded (um; a solve fails beyond
-    ``hdwf.fe.relinearise.REDETECTED_LIMIT``). NaN for tables made before the column existed, or when
-    no solve of the variant succeeded."""
-    if "max_penetration_redetected_um" not in table:
-        return float("nan")
-    pen = table.loc[table["variant"] == key, "max_penetration_redetected_um"].dropna()
-    return float(pen.max()) if len(pen) else float("nan")
+def contact_check(table: pd.DataFrame, key: str) -> dict:
+    """The solver's own check under variant ``key``: how far the tooth pairs, re-found from scratch
+    at +-T, sink into each other. Returns ``max_penetration_redetected_um`` (the largest over the
+    specimens that have it; a solve fails beyond ``hdwf.fe.relinearise.REDETECTED_LIMIT``) and
+    ``specimens_contact_unchecked``: solved specimens without it (tables made before the column
+    existed, or a coned cup, whose slices keep their settled gaps), so that no one reads the
+    largest value as covering them."""
+    rows = table[table["variant"] == key]
+    solved = rows.groupby("specimen_id")["status"].agg(lambda st: bool((st == "ok").all()))
+    if "max_penetration_redetected_um" not in rows:
+        return {"max_penetration_redetected_um": float("nan"), "specimens_contact_unchecked": int(solved.sum())}
+    per = rows.groupby("specimen_id")["max_penetration_redetected_um"].max()
+    checked = per.notna()
+    return {"max_penetration_redetected_um": float(per[checked].max()) if checked.any() else float("nan"),
+            "specimens_contact_unchecked": int((solved & ~checked.reindex(solved.index, fill_value=False)).sum())}
 
 
 def solve_ladder(meas: Measurements, table: pd.DataFrame, rungs: list[tuple[str, dict]],
