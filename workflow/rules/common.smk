@@ -84,9 +84,12 @@ def specimens_of(campaign):
         try:
             _SPECIMENS[campaign] = campaign_specimens(CAMPAIGNS[campaign])
         except MeasurementError as exc:
-            print(f"MeasurementError in campaign '{campaign}' (validation.{campaign}.measurements): {exc}\n"
-                  f"Nothing was run. Check the file with: hdwf check-measurements {CAMPAIGNS[campaign].measurements} "
-                  f"--unit {CAMPAIGNS[campaign].unit}", file=sys.stderr)
+            plan = CAMPAIGNS[campaign]
+            problems = "\n  ".join(exc.lines)    # every one, as hdwf check-measurements gives them
+            print(f"MeasurementError in campaign '{campaign}' (validation.{campaign}.measurements): "
+                  f"{len(exc.lines)} problem(s):\n  {problems}\nNothing was run. Check the file with: "
+                  f"hdwf check-measurements {plan.measurements} --unit {plan.unit} --steps-per-ramp {plan.steps_per_ramp}",
+                  file=sys.stderr)
             raise SystemExit(1)
     return _SPECIMENS[campaign]
 
