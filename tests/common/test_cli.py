@@ -95,7 +95,7 @@ def test_synth_to_parquet_records_what_made_it(tmp_path, capsys):
     """Parquet stand-in bench data carry their provenance (commit, versions) and the synthesis
     settings, from which the same seed makes the same numbers as the CSV (to its 9 digits)."""
     from hdwf.common.io import read_parquet_meta
-    from hdwf.common.provenance import config_hash
+    from hdwf.common.provenance import config_hash, git_commit
     argv = ["synth", "--unit", "hd42", "--designs", "1", "--seed", "3", "--noise-arcmin", "0.01",
             "--effect", "thermal:delta_T_K=10", "--range", "rFS_mm=0:0.002", "--elements-over-height", "4",
             "--elements-over-thickness", "2", "--refinement", "0.5", "--steps-per-ramp", "1"]
@@ -106,7 +106,7 @@ def test_synth_to_parquet_records_what_made_it(tmp_path, capsys):
     assert settings["seed"] == 3 and settings["effects"] == {"thermal": {"delta_T_K": 10.0}}
     assert settings["ranges"] == {"rFS_mm": [0.0, 0.002]} and settings["mesh"]["refinement"] == 0.5
     assert prov["config_hash"] == config_hash(settings) and prov["packages"]["numpy"] == np.__version__
-    assert prov["git_commit"]
+    assert prov["git_commit"] == git_commit(ROOT)     # the checkout hdwf runs from (pip install -e)
     pd.testing.assert_frame_equal(pd.read_parquet(tmp_path / "b.parquet"), pd.read_csv(tmp_path / "b.csv"),
                                   check_exact=False, rtol=1e-8)
     assert len(load_measurements(tmp_path / "b.parquet").specimens) == 1

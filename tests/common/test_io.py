@@ -92,6 +92,26 @@ def test_provenance_names_the_library_checkout_when_it_is_not_the_projects(tmp_p
     assert provenance({}, library)["git_commit"] == prov_module.git_commit(library)
 
 
+def test_a_tool_installed_from_no_checkout_gives_no_commit(tmp_path, monkeypatch):
+    """``hdwf synth`` installed without a checkout (its files in a venv that sits inside some other
+    repository): git, asked about that folder, would name the other repository's HEAD; the record
+    says the commit is unknown instead."""
+    import subprocess
+
+    from hdwf.common import provenance as prov_module
+    repo = tmp_path / "other"
+    site = repo / ".venv" / "lib" / "python3.11"
+    site.mkdir(parents=True)
+    git = ["git", "-C", str(repo), "-c", "user.name=t", "-c", "user.email=t@t"]
+    subprocess.run(["git", "init", "-q", str(repo)], check=True)
+    (repo / "f").write_text("x")
+    subprocess.run(git + ["add", "f"], check=True)
+    subprocess.run(git + ["commit", "-qm", "one"], check=True)
+    assert prov_module.git_commit(site).startswith(prov_module.git_commit(repo)[:40])   # what git would say
+    monkeypatch.setattr(prov_module, "_LIBRARY_ROOT", site)
+    assert prov_module.tool_provenance({"seed": 1})["git_commit"] == "unknown (hdwf is not run from a git checkout)"
+
+
 def test_failed_design_never_carries_a_number(tmp_path):
     df = pd.DataFrame({"design_id": ["a", "b"], "d_mm": [31.0, 31.0], "D_mm": [42.0, 42.0], "Gr_mm": [0.01, 0.01],
                        "rFS_mm": [0.0, 0.0], "rCS_mm": [0.0, 0.0], "lost_motion_arcmin": [0.5, 0.7],

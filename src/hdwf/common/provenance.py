@@ -56,15 +56,23 @@ def provenance(config: dict, repo_dir: str | Path = ".") -> dict:
     commit = git_commit(repo_dir)
     if _LIBRARY_ROOT != Path(repo_dir).resolve() and (_LIBRARY_ROOT / ".git").exists():
         commit += f"; hdwf library {git_commit(_LIBRARY_ROOT)}"
+    return _record(config, commit)
+
+
+def tool_provenance(settings: dict) -> dict:
+    """``provenance`` of a file a command writes outside any project (``hdwf synth``): its
+    settings stand for the config, and the commit is that of the checkout ``hdwf`` runs from.
+    An install that is no checkout (``pip install .``) has no commit to give: git, asked about
+    the folder it sits in, would name whatever repository holds that folder."""
+    if (_LIBRARY_ROOT / ".git").exists():
+        return _record(settings, git_commit(_LIBRARY_ROOT))
+    return _record(settings, "unknown (hdwf is not run from a git checkout)")
+
+
+def _record(config: dict, commit: str) -> dict:
     return {
         "config_hash": config_hash(config),
         "git_commit": commit,
         "python": platform.python_version(),
         "packages": package_versions(),
     }
-
-
-def tool_provenance(settings: dict) -> dict:
-    """``provenance`` of a file a command writes outside any project (``hdwf synth``): its
-    settings stand for the config, and the commit is that of the checkout ``hdwf`` runs from."""
-    return provenance(settings, _LIBRARY_ROOT)
