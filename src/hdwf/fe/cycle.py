@@ -232,8 +232,8 @@ def lost_motion_result(model: LostMotionModel, changes: ModelChanges, frac: np.n
     km = int(np.argmin(np.abs(frac + 1.0)))
     phi_p, phi_m = float(tw[kp]), float(-tw[km])
     # NaN where the check was not made (a coned cup's slices keep their settled gaps)
-    redetected_um = max(0.0, test.max_penetration_redetected) * 1000.0
-    redetected_um = redetected_um if math.isfinite(test.max_penetration_redetected) else float("nan")
+    pen = test.max_penetration_redetected
+    redetected_um = max(0.0, pen) * 1000.0 if math.isfinite(pen) else float("nan")
     mount = mounted.solution
     ball_N = float(mount.normal_force[[k == "ball" for k, _ in mount.pair_ids]].max(initial=0.0))
     return LostMotionResult(

@@ -337,7 +337,7 @@ def _contact_check_sentence(ladder: pd.DataFrame) -> str:
     missing = ("; ".join(f"rung {int(r['rung'])} ({lit(r['model'])}) on {int(r['specimens_contact_unchecked'])} "
                          f"specimen{'s' if r['specimens_contact_unchecked'] > 1 else ''}"
                          for r in unchecked.to_dict("records")))
-    why = ("tables solved before the check was recorded, or a coned cup, whose slices keep their settled gaps")
+    why = "tables solved before the check was recorded, or a coned cup, whose slices keep their settled gaps"
     if ladder["max_penetration_redetected_um"].isna().all():
         return f"The solver's check from scratch at ±T was not made for {missing} ({why})." if missing else ""
     worst = ladder.loc[ladder["max_penetration_redetected_um"].idxmax()]

@@ -122,10 +122,9 @@ def contact_check(table: pd.DataFrame, key: str) -> dict:
     solved = rows.groupby("specimen_id")["status"].agg(lambda st: bool((st == "ok").all()))
     if "max_penetration_redetected_um" not in rows:
         return {"max_penetration_redetected_um": float("nan"), "specimens_contact_unchecked": int(solved.sum())}
-    per = rows.groupby("specimen_id")["max_penetration_redetected_um"].max()
-    checked = per.notna()
-    return {"max_penetration_redetected_um": float(per[checked].max()) if checked.any() else float("nan"),
-            "specimens_contact_unchecked": int((solved & ~checked.reindex(solved.index, fill_value=False)).sum())}
+    per = rows.groupby("specimen_id")["max_penetration_redetected_um"].max()   # the same specimens as solved
+    return {"max_penetration_redetected_um": float(per.max()) if per.notna().any() else float("nan"),
+            "specimens_contact_unchecked": int((solved & per.isna()).sum())}
 
 
 def solve_ladder(meas: Measurements, table: pd.DataFrame, rungs: list[tuple[str, dict]],
