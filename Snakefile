@@ -16,10 +16,10 @@ from hdwf.validation.measurements import SPECIMEN_ID_PATTERN
 min_version("9.0")
 
 # glibc hands a freed array above 128 kB back to the OS and faults fresh pages in for the next
-# one; a solve allocates such temporaries thousands of times. Keeping them in the heap halves a
-# solve job's system time and takes ~3 % off the jobs (docs/fe-model.md, Time); results are the
-# same to the last bit. glibc reads these when a process starts, so they are set here, for the
-# jobs; a value already in the environment wins, HDWF_KEEP_FREED_MEMORY=0 leaves glibc's own.
+# one; a solve allocates such temporaries thousands of times. Kept in the heap, they cost the jobs
+# 3-8 % less time, with results the same to the last bit (docs/fe-model.md, Time). glibc reads
+# these when a process starts, so they are set here, for the jobs; a value already in the
+# environment wins, HDWF_KEEP_FREED_MEMORY=0 leaves glibc's own.
 if os.environ.get("HDWF_KEEP_FREED_MEMORY", "1") != "0":
     for _name, _value in {"MALLOC_MMAP_THRESHOLD_": "33554432", "MALLOC_TRIM_THRESHOLD_": "4294967296",
                           "MALLOC_TOP_PAD_": "268435456"}.items():
