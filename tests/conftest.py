@@ -8,6 +8,7 @@ import os
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
+import shutil  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -21,6 +22,16 @@ DATA = ROOT / "data" / "paper"
 @pytest.fixture
 def paper_dir():
     return DATA
+
+
+def copy_workflow(dest: Path, extra: tuple[str, ...] = ()) -> Path:
+    """A copy of the workflow (Snakefile, config, rules and scripts, data, and ``extra`` paths) in
+    ``dest``, with no results: Snakemake keeps its logs and state in the project it runs in."""
+    for item in ("Snakefile", "config.yaml", "workflow", "data", *extra):
+        src, dst = ROOT / item, dest / item
+        dst.parent.mkdir(parents=True, exist_ok=True)
+        (shutil.copytree if src.is_dir() else shutil.copy)(src, dst)
+    return dest
 
 
 # The test files that take minutes, longest first (`pytest -n 2 --durations=0`, summed per

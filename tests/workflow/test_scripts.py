@@ -1,23 +1,18 @@
 """Rule scripts run by hand too (``python workflow/scripts/<rule>.py``), as under Snakemake."""
 
 import os
-import shutil
 import subprocess
 import sys
 
 import pandas as pd
 import pytest
 
-from conftest import DATA, ROOT
+from conftest import DATA, ROOT, copy_workflow
 
 
 @pytest.mark.slow
 def test_a_script_runs_outside_snakemake_from_any_folder(tmp_path):
-    project = tmp_path / "project"
-    project.mkdir()
-    for item in ("Snakefile", "config.yaml", "workflow", "data"):
-        src = ROOT / item
-        (shutil.copytree if src.is_dir() else shutil.copy)(src, project / item)
+    project = copy_workflow(tmp_path / "project")
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
     run = subprocess.run([sys.executable, str(project / "workflow/scripts/paper_lost_motion.py")], cwd=elsewhere,
@@ -67,9 +62,7 @@ print(*(os.environ.get(k, "-") for k in ("MALLOC_MMAP_THRESHOLD_", "MALLOC_TRIM_
 def test_the_snakefile_starts_jobs_with_freed_memory_kept(env, expected, tmp_path):
     """glibc reads its MALLOC_* settings when a process starts, so the Snakefile sets them for the
     jobs it starts (docs/fe-model.md, Time: 7.7 % off two study jobs at once)."""
-    for item in ("Snakefile", "config.yaml", "workflow", "data"):   # Snakemake logs in its project
-        src = ROOT / item
-        (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp_path / item)
+    copy_workflow(tmp_path)
     base = {k: v for k, v in os.environ.items() if not k.startswith("MALLOC_") and k != "HDWF_KEEP_FREED_MEMORY"}
     run = subprocess.run([sys.executable, "-c", _PARSE_SNAKEFILE, str(tmp_path)], env={**base, **env},
                          capture_output=True, text=True, timeout=120)

@@ -16,7 +16,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from conftest import ROOT
+from conftest import copy_workflow
 
 SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))
 DESIGN = "paper-08"
@@ -58,10 +58,7 @@ def _workspace(path):
     import yaml
 
     path.mkdir()
-    for item in ("Snakefile", "config.yaml", "workflow", "data", "profiles/slurm"):
-        src, dst = ROOT / item, path / item
-        dst.parent.mkdir(parents=True, exist_ok=True)
-        (shutil.copytree if src.is_dir() else shutil.copy)(src, dst)
+    copy_workflow(path, extra=("profiles/slurm",))
     config = yaml.safe_load((path / "config.yaml").read_text())
     study = config["studies"]["fe_at_paper"]
     config["studies"] = {"fe_at_paper": {**study, "units": ["hd42"]}}

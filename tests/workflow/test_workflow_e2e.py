@@ -2,7 +2,6 @@
 
 import os
 import re
-import shutil
 import signal
 import subprocess
 import sys
@@ -17,16 +16,13 @@ from hdwf.common.io import read_json, read_parquet_meta
 from hdwf.common.provenance import config_hash
 from hdwf.config import load_config
 
-from conftest import ROOT
+from conftest import ROOT, copy_workflow
 
 SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))
 
 
 def _workspace(tmp_path):
-    for item in ("Snakefile", "config.yaml", "workflow", "data"):
-        src = ROOT / item
-        (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp_path / item)
-    return tmp_path
+    return copy_workflow(tmp_path)
 
 
 @pytest.fixture(scope="module")
