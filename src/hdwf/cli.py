@@ -90,23 +90,41 @@ def _provenance(args) -> int:
 
 
 def _refuse_existing(out: Path, args, why: str = "") -> None:
-    """An existing output file is kept unless --force says otherwise; a folder is never replaced."""
+    """An existing output file is kept unless --force says otherwise; a folder is never replaced.
+    Its folder is checked too, before a long solve, not after it."""
     if out.is_dir():
         raise InputError(out, "is a folder: name the output file", field="--out")
     if out.exists() and not args.force:
         raise InputError(out, f"exists; {why}use --force to replace it", field="--out")
+    _check_folder(out)
+
+
+def _check_folder(out: Path) -> None:
+    """The nearest existing folder above ``out`` must be a folder this process can write in."""
+    parent = out.absolute().parent
+    while not parent.exists():
+        parent = parent.parent
+    if not parent.is_dir():
+        raise InputError(out, f"cannot be written: {parent} is a file, not a folder", field="--out")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise InputError(out, f"cannot be written: no permission to write in {parent}", field="--out")
 
 
 @contextmanager
 def _new_output(out: Path, args):
     """``atomic_path`` that replaces only with --force: a file made at ``out`` while a long solve ran
     (after ``_refuse_existing`` looked) is kept too."""
+    _check_folder(out)
     try:
         with atomic_path(out, replace=args.force) as tmp:
             yield tmp
     except FileExistsError:
+        if not out.exists():
+            raise
         raise InputError(out, "was made by something else while this ran: it is kept and nothing was written; "
                               "use --force to replace it", field="--out") from None
+    except OSError as exc:
+        raise InputError(out, f"cannot be written: {exc.strerror or exc}", field="--out") from None
 
 
 def _solve_setup(args) -> SolveSetup:
@@ -188,7 +206,8 @@ def _synth(args) -> int:
         try:
             name, pname, value = parse_assignment(text)
         except (KeyError, ValueError) as exc:
-            raise InputError("command line", str(exc).strip("'\""), field="--effect", value=text) from None
+            problem = str(exc).strip("'\"").removeprefix(f"--effect {text!r}: ")   # the field and value say that
+            raise InputError("command line", problem, field="--effect", value=text) from None
         if pname in effects.get(name, {}):
             raise InputError("command line", f"{name}:{pname} is given twice", field="--effect", value=text)
         effects.setdefault(name, {})[pname] = value

@@ -9,6 +9,7 @@ from __future__ import annotations
 import functools
 import json
 import math
+import re
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -61,7 +62,9 @@ def validate_config(config: dict, schema_path: str | Path = SCHEMA_PATH,
         blamed on the last file that sets the offending key, or on ``--config`` if none does.
     """
     sources = [source] if isinstance(source, (str, Path)) else list(source)
+    _null_clears_a_mapping(config, _schema(str(schema_path)))
     try:
+        _empty_overlay_mappings(sources, config)
         _check_schema(config, schema_path, sources[-1])
         _check_relations(config, sources[-1])
     except ConfigError as exc:
@@ -127,6 +130,53 @@ def _not_a_number(value, path: str = "") -> str | None:
     return None
 
 
+def _null_clears_a_mapping(node: dict, schema: dict) -> None:
+    """``key: null`` where the schema wants a mapping with a default reads as that default (``{}``).
+
+    Overlays merge mapping into mapping, so an overlay's ``fe: {effects: {}}`` changes nothing;
+    ``effects: null`` replaces the base's mapping, and this turns it into the empty one.
+    """
+    props = schema.get("properties", {})
+    extra = schema.get("additionalProperties")
+    for key, value in node.items():
+        sub = props.get(key, extra if isinstance(extra, dict) else None)
+        if not isinstance(sub, dict):
+            continue
+        if value is None and sub.get("type") == "object" and isinstance(sub.get("default"), dict):
+            node[key] = dict(sub["default"])
+        elif isinstance(value, dict):
+            _null_clears_a_mapping(value, sub)
+
+
+def _empty_overlay_mappings(sources: list[str | Path], config: dict) -> None:
+    """Refuse an overlay's empty mapping over a non-empty one: it merges into nothing, so the run
+    would keep what the user meant to clear (the studies' effects, say) and say nothing."""
+    for path in sources[1:]:
+        try:
+            overlay = yaml.safe_load(Path(path).read_text())
+        except (OSError, UnicodeDecodeError, yaml.YAMLError):
+            continue
+        for field in _empty_mappings(overlay):
+            merged = config
+            for key in field.split("."):
+                merged = merged.get(key) if isinstance(merged, dict) else None
+            if isinstance(merged, dict) and merged:
+                raise ConfigError(path, "an empty mapping in an overlay merges into the base's and clears nothing "
+                                        f"(it keeps {', '.join(map(str, merged))}): write null to clear it",
+                                  field=field, value={})
+
+
+def _empty_mappings(node, path: str = "") -> Iterator[str]:
+    if not isinstance(node, dict):
+        return
+    for key, value in node.items():
+        here = f"{path}.{key}" if path else str(key)
+        if value == {}:
+            yield here
+        else:
+            yield from _empty_mappings(value, here)
+
+
 def _check_schema(config: dict, schema_path: str | Path, source) -> None:
     nan_at = _not_a_number(config)
     if nan_at:
@@ -147,7 +197,20 @@ def _check_schema(config: dict, schema_path: str | Path, source) -> None:
         first = errors[0]
         others = _and_the_others([f"{_key_path(e)}: {e.message}" for e in errors[1:]])
         value = first.instance if not isinstance(first.instance, (dict, list)) else None
-        raise ConfigError(source, f"{first.message}{others}", field=_key_path(first), value=value)
+        field = _key_path(first)
+        unexpected = _unexpected_keys(first)
+        if unexpected:   # name the key itself, so the file that holds it is the one blamed
+            field = ".".join(p for p in (*map(str, first.absolute_path), unexpected[0]))
+        raise ConfigError(source, f"{first.message}{others}", field=field, value=value)
+
+
+def _unexpected_keys(error: jsonschema.ValidationError) -> list[str]:
+    """The keys an ``additionalProperties: false`` error refuses (none for any other error)."""
+    if error.validator != "additionalProperties" or not isinstance(error.instance, dict):
+        return []
+    known = set(error.schema.get("properties", {}))
+    patterns = [re.compile(p) for p in error.schema.get("patternProperties", {})]
+    return sorted(k for k in error.instance if k not in known and not any(p.search(k) for p in patterns))
 
 
 def _and_the_others(problems: list[str], shown: int = 10) -> str:
@@ -249,12 +312,14 @@ def _effect_problems(where: str, effects: dict, source) -> Iterator[ConfigError]
 
 def _read_yaml(path: Path) -> dict:
     try:
-        loaded = yaml.safe_load(path.read_text()) or {}
+        loaded = yaml.safe_load(path.read_text())
     except (OSError, UnicodeDecodeError) as exc:
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else "not a text file"
         raise ConfigError(path, f"cannot read the config: {reason}") from exc
     except yaml.YAMLError as exc:
         raise ConfigError(path, f"not valid YAML: {exc}") from exc
+    if loaded is None:
+        raise ConfigError(path, "the file is empty: a config needs keys at its top level (Snakemake refuses it too)")
     if not isinstance(loaded, dict):
         raise ConfigError(path, f"the top level must be keys and values (a mapping), not a {type(loaded).__name__}")
     return loaded

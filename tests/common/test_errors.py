@@ -1,6 +1,7 @@
 """Bad input is refused with a message naming file, field (and row, value)."""
 
 import shutil
+from pathlib import Path
 
 import pytest
 import yaml
@@ -232,6 +233,36 @@ def test_an_output_that_is_a_folder_is_refused_even_with_force(tmp_path, capsys,
     assert capsys.readouterr().err.strip() == f"hdwf: error: {folder}, field '--out': is a folder: name the output file"
 
 
+@pytest.mark.parametrize("command", [["plan", "--unit", "hd42", "--designs", "2", "--seed", "1", "--noise-arcmin", "0.05"],
+                                     ["synth", "--unit", "hd42", "--designs", "2", "--seed", "1", "--noise-arcmin", "0.05"]])
+def test_an_output_under_a_file_is_refused_before_any_solve(tmp_path, capsys, monkeypatch, command):
+    """--out data.csv/x.csv, data.csv a file, was found only after every solve, and then reported
+    as a file "made by something else while this ran". Now it is refused first, naming the file."""
+    import hdwf.cli as cli
+
+    def no_solve(*args, **kwargs):
+        raise AssertionError("solved before the output was checked")
+
+    monkeypatch.setattr(cli, "synthesize", no_solve)
+    monkeypatch.setattr(cli, "plan_detectability", no_solve)
+    blocker = tmp_path / "data.csv"
+    blocker.write_text("keep me")
+    out = blocker / ("x.json" if command[0] == "plan" else "x.csv")
+    rc = main([*command, "--out", str(out)])
+    assert rc == 2 and blocker.read_text() == "keep me"
+    assert capsys.readouterr().err.strip() == (f"hdwf: error: {out}, field '--out': cannot be written: "
+                                               f"{blocker} is a file, not a folder")
+
+
+def test_an_output_that_cannot_be_written_is_an_input_error_not_a_traceback(tmp_path, capsys):
+    """A folder the system refuses (here /proc) ended in a FileNotFoundError traceback after the
+    work; it is an error on --out, exit 2, and nothing is left behind."""
+    out = Path("/proc/hdwf-test/m.csv")
+    rc = main(["paper-measurements", "--unit", "hd42", "--data", str(DATA), "--out", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and err.startswith(f"hdwf: error: {out}, field '--out': cannot be written: ") and not out.exists()
+
+
 def test_paper_measurements_keeps_a_file_made_at_out_while_it_ran(tmp_path, capsys, monkeypatch):
     """The --out check comes before the work; a file made there meanwhile (another run, a user)
     was replaced by the final rename. Now it is kept and the command says so, exit 2."""
@@ -265,6 +296,46 @@ def test_a_config_and_its_overlay_merge_key_by_key_and_a_bad_key_is_blamed_on_it
     with pytest.raises(ConfigError) as exc:
         load_config([ROOT / "config.yaml", overlay], SCHEMA)
     assert str(exc.value).startswith(f"{overlay}, field 'fe.steps_per_ramp', value 0:")
+
+
+@pytest.mark.parametrize("text, field, unexpected", [("sobl:\n  x: 1\n", "sobl", "sobl"),
+                                                     ("doe:\n  n_design: 3\n", "doe.n_design", "n_design")])
+def test_an_unknown_key_of_an_overlay_is_blamed_on_the_overlay_by_its_full_name(tmp_path, text, field, unexpected):
+    """A misspelt top-level key of an overlay was blamed on '--config (command line)', which the
+    user never gave, as field '(top level)'; the field is now the key itself, in the overlay."""
+    overlay = tmp_path / "overlay.yaml"
+    overlay.write_text(text)
+    with pytest.raises(ConfigError) as exc:
+        load_config([ROOT / "config.yaml", overlay], SCHEMA)
+    assert str(exc.value).startswith(f"{overlay}, field '{field}': Additional properties are not allowed "
+                                     f"('{unexpected}' was unexpected)")
+
+
+def test_an_overlay_clears_the_studies_effects_with_null_and_an_empty_mapping_is_refused(tmp_path):
+    """Overlays merge mapping into mapping (as Snakemake's --configfile), so `effects: {}` kept the
+    preload and flank layer on and said nothing: the bare section a user asked for was never
+    solved. null clears the mapping; {} over a non-empty mapping is an error naming the fix."""
+    base = load_config(ROOT / "config.yaml", SCHEMA)
+    assert base["fe"]["effects"], "the default studies' model has effects to clear"
+    overlay = tmp_path / "bare.yaml"
+    overlay.write_text("fe:\n  effects: null\n")
+    assert load_config([ROOT / "config.yaml", overlay], SCHEMA)["fe"]["effects"] == {}
+    overlay.write_text("fe:\n  effects: {}\n")
+    with pytest.raises(ConfigError) as exc:
+        load_config([ROOT / "config.yaml", overlay], SCHEMA)
+    assert str(exc.value).startswith(f"{overlay}, field 'fe.effects', value {{}}: an empty mapping in an overlay")
+    assert str(exc.value).endswith("write null to clear it")
+    overlay.write_text("validation:\n  demo:\n    effects: {}\n")   # empty over empty: nothing to clear
+    assert load_config([ROOT / "config.yaml", overlay], SCHEMA)["validation"]["demo"]["effects"] == {}
+
+
+def test_an_empty_config_file_is_refused_as_snakemake_refuses_it(tmp_path):
+    """check-config called an empty overlay valid; Snakemake stops on it ('keys at top level')."""
+    empty = tmp_path / "empty.yaml"
+    empty.write_text("")
+    with pytest.raises(ConfigError) as exc:
+        load_config([ROOT / "config.yaml", empty], SCHEMA)
+    assert str(exc.value).startswith(f"{empty}: the file is empty")
 
 
 def test_every_relation_problem_is_listed_not_only_the_first(tmp_path):

@@ -63,3 +63,20 @@ def test_every_documented_hdwf_command_line_is_accepted():
             parser.parse_args(argv)
         except SystemExit:
             raise AssertionError(f"{doc}: `{command}` is refused by the CLI") from None
+
+
+def test_every_configfile_the_readme_names_is_shipped_and_valid():
+    """`--configfile hd42.yaml` in the README named a file nobody had: a newcomer met a raw
+    FileNotFoundError. Every overlay the README runs is shipped and valid over config.yaml."""
+    from hdwf.config import SCHEMA_PATH, load_config
+
+    readme = (ROOT / "README.md").read_text()
+    overlays = sorted(set(re.findall(r"--configfile (\S+\.yaml)", readme)))
+    assert "workflow/overlays/hd42_only.yaml" in overlays and "workflow/overlays/bare_section.yaml" in overlays
+    for overlay in overlays:
+        config = load_config([ROOT / "config.yaml", ROOT / overlay], SCHEMA_PATH)
+        assert isinstance(config["studies"], dict), overlay
+    bare = load_config([ROOT / "config.yaml", ROOT / "workflow/overlays/bare_section.yaml"], SCHEMA_PATH)
+    assert bare["fe"]["effects"] == {}
+    one_drive = load_config([ROOT / "config.yaml", ROOT / "workflow/overlays/hd42_only.yaml"], SCHEMA_PATH)
+    assert {s: one_drive["studies"][s]["units"] for s in ("fe", "fe_at_paper")} == {"fe": ["hd42"], "fe_at_paper": ["hd42"]}

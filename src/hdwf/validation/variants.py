@@ -267,7 +267,7 @@ def solve_specimens(setup: SolveSetup, specimens: pd.DataFrame,
     tasks = [(setup, {"specimen_id": r["specimen_id"], **{c: float(r[c]) for c in PARAMETER_COLUMNS}},
               variants_of(r["specimen_id"])) for _, r in specimens.iterrows()]
     n_solves = sum(len(t[2]) for t in tasks)
-    with tqdm(total=len(tasks), desc=f"{setup.unit}: {n_solves} solves", unit="specimen",
+    with tqdm(total=len(tasks), desc=f"{setup.unit}: {len(tasks)} specimens, {n_solves} solves", unit="specimen",
               disable=not setup.progress, file=sys.stderr) as bar:
         if setup.jobs <= 1 or len(tasks) <= 1:
             out = []
