@@ -689,3 +689,27 @@ def test_the_residual_panels_stay_legible_at_page_width(monkeypatch):
         visible = [ax for ax in fig.axes if ax.get_visible()]
         assert len(visible) == shown and len(fig.axes) == 6
         assert fig.get_figwidth() == 9 and len({ax.get_position().x0 for ax in fig.axes}) == 3   # 3 a row, page-wide
+
+
+def test_catalogue_section_holds_each_level_against_two_t_over_k1(named_inputs, tmp_path):
+    """HD 42 against the CSF-17 (K1 0.81e4 N m/rad): 2T/K1 = 0.815 arcmin; the paper's median Φ and
+    ours (here the paper's times 2) each with its ratio to that, and the PDF typesets the table."""
+    import dataclasses
+
+    import pandas as pd
+
+    from hdwf.report.catalogue_part import catalogue_section
+
+    paper = study_artefacts("paper", STUDY, artefacts_by_owner(*named_inputs))
+    table = pd.read_parquet(paper.drive("hd42").lost_motion)
+    table["lost_motion_arcmin"] *= 2
+    table.to_parquet(tmp_path / "doubled.parquet")
+    ours = dataclasses.replace(paper, name="fe_at_paper", source="fe",
+                               drives=(dataclasses.replace(paper.drive("hd42"), lost_motion=tmp_path / "doubled.parquet"),))
+    doc = Document("t", "s", PROVENANCE)
+    catalogue_section(doc, ["hd42"], paper, [ours])
+    row = next(b for b in doc.blocks if b["type"] == "table")["rows"][0]
+    median = table["lost_motion_arcmin"].median() / 2
+    assert row[:3] == ["HD 42", "CSF-17: 0.81", "0.815"]
+    assert row[3] == f"{median:.3f} ({median / 0.8148:.2f}×)" and row[4] == f"{2 * median:.3f} ({2 * median / 0.8148:.2f}×)"
+    assert "Against makers' catalogues" in _pdf_text(doc.compile(tmp_path / "catalogue.pdf"))

@@ -17,6 +17,7 @@ from hdwf.fe.hertz import ISO76_BALL_PRESSURE_MPA
 from hdwf.fe.solver import TOL_GAP
 from hdwf.report.agreement_part import AGREEMENT_TARGETS, agreement_section, effects_text
 from hdwf.report.artefacts import FeSettings, ReportInputs, StudyArtefacts
+from hdwf.report.catalogue_part import catalogue_section
 from hdwf.report.document import UNIT_NAMES, Document, fmt, lit, math_label
 from hdwf.report.figures import curves_figure
 from hdwf.report.knee_part import knee_section, rank_split_section
@@ -342,6 +343,7 @@ def fe_part(doc: Document, report: ReportInputs, tmp: Path) -> None:
         knee_section(doc, units, report.data_dir, paper_studies[0], at_paper[0], tmp, 2)
         rank_split_section(doc, units, report.data_dir, paper_studies[0], at_paper[0],
                            AGREEMENT_TARGETS["spearman"], 2)
+        catalogue_section(doc, units, paper_studies[0], fe_studies, report.fe_settings, 2)
     all_units = sorted({u for s in fe_studies for u in s.units}, key=["hd42", "hd120"].index)
     indices_vs_paper_section(doc, all_units, report.data_dir, paper_studies + fe_studies, 2)
     for study in fe_studies:

@@ -1,0 +1,57 @@
+"""Part II of the report: the lost motion of our model and the paper's against makers' catalogues
+(``hdwf.study.catalogue``): the elastic Φ = 2T/K1 of a real unit of the same size."""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from hdwf.drive.geometry import unit_data
+from hdwf.report.agreement_part import drive_role
+from hdwf.report.artefacts import FeSettings, StudyArtefacts
+from hdwf.report.document import UNIT_NAMES, Document, fmt
+from hdwf.study.catalogue import CatalogueCheck, catalogue_check, catalogue_units, size_ratio
+
+
+def _lost_motion(study: StudyArtefacts, unit: str) -> pd.Series:
+    table = pd.read_parquet(study.drive(unit).lost_motion)
+    return table["lost_motion_arcmin"]
+
+
+def _with_ratio(check: CatalogueCheck, name: str) -> str:
+    lo, hi = check.ratio(name)
+    span = fmt(lo, 2) if f"{lo:.2f}" == f"{hi:.2f}" else f"{fmt(lo, 2)}–{fmt(hi, 2)}"
+    return f"{fmt(check.levels_arcmin[name], 3)} ({span}×)"
+
+
+def catalogue_section(doc: Document, units: list[str], paper: StudyArtefacts, fe_studies: list[StudyArtefacts],
+                      settings: FeSettings | None = None, level: int = 2) -> None:
+    """Median Φ of the paper's tables and of each FE study against the catalogue units' 2T/K1."""
+    doc.heading("Against makers' catalogues", level)
+    levels = {"paper": "the paper's FEA"} | {s.name: f"ours, `{s.name}`" for s in fe_studies}
+    checks, rows = {}, []
+    for u in units:
+        values = {"paper": _lost_motion(paper, u)} | {s.name: _lost_motion(s, u) for s in fe_studies if u in s.units}
+        check = catalogue_check(u, unit_data(u).torque_Nmm / 1000.0, values)
+        checks[u] = check
+        cat = catalogue_units(u)
+        lo, hi = check.catalogue_phi_arcmin
+        rows.append([UNIT_NAMES[u] + drive_role(settings, u),
+                     ", ".join(f"{c.series}-{c.size}: {fmt(c.k1_Nm_per_rad / 1e4, 2)}" for c in cat),
+                     fmt(lo, 3) if len(cat) == 1 else f"{fmt(lo, 3)}–{fmt(hi, 3)}",
+                     *(_with_ratio(check, name) if name in check.levels_arcmin else "–" for name in levels)])
+    doc.table(["drive", "catalogue $K_1$ ($10^4$ N·m/rad)", "catalogue $2T slash K_1$",
+               *(f"median $Phi$, {label} (over the catalogue's)" for label in levels.values())], rows,
+              "Elastic lost motion at ±T of a real unit of the same size, $2T slash K_1$ (arcmin; Harmonic Drive "
+              "CSF, ratio 50; ±T lies below $T_1$), against the median $Phi$ of each set of designs.")
+    text = ("A catalogue unit is measured whole, cup, diaphragm, bearing and teeth, by its maker: no model of ours "
+            "or the paper's made these numbers. Its backlash and hysteresis (of the order of an arcminute at $T_N$) "
+            "are left out here, so $2T slash K_1$ is the part a frictionless model should give.")
+    if "hd42" in checks and "hd120" in checks:
+        small, large = checks["hd42"], checks["hd120"]
+        c_lo, c_hi = size_ratio(small, large)
+        said = [f"the catalogue {fmt(c_lo, 2)}–{fmt(c_hi, 2)}"]
+        said += [f"{label} {fmt(size_ratio(small, large, name)[0], 2)}" for name, label in levels.items()
+                 if name in small.levels_arcmin and name in large.levels_arcmin]
+        text += (" Torque and stiffness both grow with the size cubed, so both drives should show about the same "
+                 "lost motion in arcmin; HD 120's over HD 42's: " + "; ".join(said) + ".")
+    doc.text(text)
