@@ -276,6 +276,9 @@ def _plan(args) -> int:
 def _paper_measurements(args) -> int:
     out = Path(args.out)
     _refuse_existing(out, args, "measurement files are never overwritten: ")
+    if not Path(args.data).is_dir():
+        raise InputError(args.data, "no such folder: run this in the project folder, or give --data the folder "
+                                    "of the paper's tables", field="--data")
     data = paper_measurements(args.data, args.unit)
     with _new_output(out, args) as tmp:
         data.to_csv(tmp, index=False, float_format="%.10g")

@@ -352,3 +352,13 @@ def test_every_relation_problem_is_listed_not_only_the_first(tmp_path):
     assert "field 'fe.effects', value 'preloud': unknown effect" in msg and "(and 2 more problem(s): " in msg
     assert "fe.picture.study: must name an fe study" in msg
     assert "sobol.n_start: must be a power of two" in msg
+
+
+def test_paper_measurements_outside_the_project_says_where_the_tables_are(tmp_path, capsys, monkeypatch):
+    """Run outside the project folder, --data's default data/paper is not there: the error says
+    to run it in the project or give --data, instead of naming a missing table file."""
+    monkeypatch.chdir(tmp_path)
+    rc = main(["paper-measurements", "--unit", "hd42", "--out", str(tmp_path / "t4.csv")])
+    assert rc == 2 and not (tmp_path / "t4.csv").exists()
+    assert capsys.readouterr().err.strip() == ("hdwf: error: data/paper, field '--data': no such folder: run this in the "
+                                               "project folder, or give --data the folder of the paper's tables")
