@@ -36,7 +36,7 @@ def catalogue_section(doc: Document, units: list[str], paper: StudyArtefacts, fe
         cat = catalogue_units(u)
         lo, hi = check.catalogue_phi_arcmin
         rows.append([UNIT_NAMES[u] + drive_role(settings, u),
-                     ", ".join(f"{c.series}-{c.size}: {fmt(c.k1_Nm_per_rad / 1e4, 2)}" for c in cat),
+                     ", ".join(f"{c.series}-{c.size}: {c.k1_Nm_per_rad / 1e4:g}" for c in cat),
                      fmt(lo, 3) if len(cat) == 1 else f"{fmt(lo, 3)}–{fmt(hi, 3)}",
                      *(_with_ratio(check, name) if name in check.levels_arcmin else "–" for name in levels)])
     doc.table(["drive", "catalogue $K_1$ ($10^4$ N·m/rad)", "catalogue $2T slash K_1$",
@@ -53,5 +53,5 @@ def catalogue_section(doc: Document, units: list[str], paper: StudyArtefacts, fe
         said += [f"{label} {fmt(size_ratio(small, large, name)[0], 2)}" for name, label in levels.items()
                  if name in small.levels_arcmin and name in large.levels_arcmin]
         text += (" Torque and stiffness both grow with the size cubed, so both drives should show about the same "
-                 "lost motion in arcmin; HD 120's over HD 42's: " + "; ".join(said) + ".")
+                 "lost motion in arcmin. The median $Phi$ of HD 120 over that of HD 42: " + "; ".join(said) + ".")
     doc.text(text)
