@@ -713,3 +713,22 @@ def test_catalogue_section_holds_each_level_against_two_t_over_k1(named_inputs, 
     assert row[:3] == ["HD 42", "CSF-17: 0.81", "0.815"]
     assert row[3] == f"{median:.3f} ({median / 0.8148:.2f}×)" and row[4] == f"{2 * median:.3f} ({2 * median / 0.8148:.2f}×)"
     assert "Against makers' catalogues" in _pdf_text(doc.compile(tmp_path / "catalogue.pdf"))
+
+
+def test_catalogue_section_says_when_the_papers_drives_leave_the_size_law_and_ours_do_not():
+    """The paper's HD 120 at 3.7 times its HD 42 where the catalogue has 0.89-1.19; a study calibrated
+    on HD 42 at 1.4: the text says the paper's tables leave the size law by 3.1x, ours by 1.2x. A
+    study that leaves it further than the paper gets no such sentence."""
+    from hdwf.drive.design import MeshSettings
+    from hdwf.report.artefacts import FeSettings
+    from hdwf.report.catalogue_part import _blind_sentence
+    from hdwf.study.catalogue import catalogue_check
+
+    settings = FeSettings(MeshSettings(), 5, effects={"preload": {"interference_m": 0.3}}, calibrated_on="hd42")
+    small = catalogue_check("hd42", 0.96, {"paper": [0.339], "fe": [0.345]})
+    large = catalogue_check("hd120", 21.16, {"paper": [1.244], "fe": [0.477]})
+    said = _blind_sentence(small, large, settings)
+    assert "3.08× off the catalogue's ratio, ours at most 1.16×" in said and "to HD 120" in said
+    far = catalogue_check("hd120", 21.16, {"paper": [1.244], "fe": [2.0]})
+    assert _blind_sentence(small, far, settings) == ""
+    assert _blind_sentence(small, large, FeSettings(MeshSettings(), 5)) == ""
