@@ -600,6 +600,10 @@ def test_the_summary_gathers_each_parts_headline_figure(named_inputs, tmp_path):
     assert by_what["HD 42 (calibrated): our $Phi$ over the paper's, median"][:3] == ["1.20", "[0.67, 1.5]", "yes"]
     assert by_what["HD 42 (calibrated): Spearman $rho$, ours against the paper's"][0] == "1.0000"
     assert by_what["HD 42 (calibrated): $d Phi slash d r_\"FS\"$, ours over the paper's"][0] == "1.20×"
+    # against the CSF-17's 2T/K1 = 0.815 arcmin, ours is 1.2 times the paper's ratio
+    median = table["lost_motion_arcmin"].median() / 1.2
+    catalogue = by_what["HD 42 (calibrated): median $Phi$ over a catalogue unit's $2T slash K_1$ (the paper's in brackets)"]
+    assert catalogue[:3] == [f"{1.2 * median / 0.81487:.2f}× ({median / 0.81487:.2f}×)", "CSF-17: 0.815 arcmin", "–"]
     ladder = next(r for r in rows if r[0].startswith("`paper_hd42` (HD 42)"))
     assert ladder[1:4] == ["8.960 → 0.194 arcmin (46.19×)", "stated noise 0.190 arcmin", "–"]
     assert ladder[0].endswith(f"found preload, {lit('fs_cup_torsion')}")

@@ -23,16 +23,32 @@ def _with_ratio(check: CatalogueCheck, name: str) -> str:
     return f"{fmt(check.levels_arcmin[name], 3)} ({span}×)"
 
 
+def catalogue_checks(units: list[str], paper: StudyArtefacts, fe_studies: list[StudyArtefacts]
+                     ) -> dict[str, CatalogueCheck]:
+    """Per drive, the paper's median Φ (level ``paper``) and each FE study's (by its name) against
+    the catalogue units it compares with."""
+    checks = {}
+    for u in units:
+        values = {"paper": _lost_motion(paper, u)} | {s.name: _lost_motion(s, u) for s in fe_studies if u in s.units}
+        checks[u] = catalogue_check(u, unit_data(u).torque_Nmm / 1000.0, values)
+    return checks
+
+
+def catalogue_phi_text(check: CatalogueCheck) -> str:
+    """The compared units and their 2T/K1, e.g. ``CSF-17: 0.815 arcmin``."""
+    lo, hi = check.catalogue_phi_arcmin
+    units = " and ".join(f"CSF-{size}" for size in check.sizes)
+    return f"{units}: {fmt(lo, 3)} arcmin" if len(check.sizes) == 1 else f"{units}: {fmt(lo, 3)}–{fmt(hi, 3)} arcmin"
+
+
 def catalogue_section(doc: Document, units: list[str], paper: StudyArtefacts, fe_studies: list[StudyArtefacts],
                       settings: FeSettings | None = None, level: int = 2) -> None:
     """Median Φ of the paper's tables and of each FE study against the catalogue units' 2T/K1."""
     doc.heading("Against makers' catalogues", level)
     levels = {"paper": "the paper's FEA"} | {s.name: f"ours, `{s.name}`" for s in fe_studies}
-    checks, rows = {}, []
+    checks, rows = catalogue_checks(units, paper, fe_studies), []
     for u in units:
-        values = {"paper": _lost_motion(paper, u)} | {s.name: _lost_motion(s, u) for s in fe_studies if u in s.units}
-        check = catalogue_check(u, unit_data(u).torque_Nmm / 1000.0, values)
-        checks[u] = check
+        check = checks[u]
         cat = catalogue_units(u)
         lo, hi = check.catalogue_phi_arcmin
         rows.append([UNIT_NAMES[u] + drive_role(settings, u),
