@@ -94,7 +94,7 @@ def _refuse_existing(out: Path, args, why: str = "") -> None:
     Its folder is checked too, before a long solve, not after it."""
     if out.is_dir():
         raise InputError(out, "is a folder: name the output file", field="--out")
-    if out.exists() and not args.force:
+    if (out.exists() or out.is_symlink()) and not args.force:
         raise InputError(out, f"exists; {why}use --force to replace it", field="--out")
     _check_folder(out)
 
@@ -118,13 +118,19 @@ def _new_output(out: Path, args):
     try:
         with atomic_path(out, replace=args.force) as tmp:
             yield tmp
-    except FileExistsError:
-        if not out.exists():
-            raise
+    except FileExistsError as exc:
+        if not (out.exists() or out.is_symlink()):
+            raise InputError(out, f"cannot be written: {_os_reason(exc)}", field="--out") from None
         raise InputError(out, "was made by something else while this ran: it is kept and nothing was written; "
                               "use --force to replace it", field="--out") from None
     except OSError as exc:
-        raise InputError(out, f"cannot be written: {exc.strerror or exc}", field="--out") from None
+        raise InputError(out, f"cannot be written: {_os_reason(exc)}", field="--out") from None
+
+
+def _os_reason(exc: OSError) -> str:
+    """The system's reason and the path it names, e.g. ``No such file or directory (/proc/x)``."""
+    where = f" ({exc.filename})" if exc.filename else ""
+    return f"{exc.strerror or exc}{where}"
 
 
 def _solve_setup(args) -> SolveSetup:

@@ -64,7 +64,7 @@ def validate_config(config: dict, schema_path: str | Path = SCHEMA_PATH,
     sources = [source] if isinstance(source, (str, Path)) else list(source)
     _null_clears_a_mapping(config, _schema(str(schema_path)))
     try:
-        _empty_overlay_mappings(sources, config)
+        _empty_overlay_mappings(sources, config, _schema(str(schema_path)))
         _check_schema(config, schema_path, sources[-1])
         _check_relations(config, sources[-1])
     except ConfigError as exc:
@@ -90,6 +90,8 @@ def blame(sources: list[str | Path], field: str, value=None) -> str:
         except (OSError, UnicodeDecodeError, yaml.YAMLError):
             continue
         for key in field.split("."):
+            if isinstance(node, dict) and key.isdigit() and key not in node and int(key) in node:
+                key = int(key)   # YAML's `7:` is a number, the dotted field its text
             if isinstance(node, dict) and key in node:
                 node = node[key]
             elif isinstance(node, list) and key.isdigit() and int(key) < len(node):
@@ -130,6 +132,22 @@ def _not_a_number(value, path: str = "") -> str | None:
     return None
 
 
+def _clearable(schema: dict | None) -> bool:
+    """Whether ``key: null`` clears this key (``_null_clears_a_mapping``): a mapping with a ``{}`` default."""
+    return isinstance(schema, dict) and schema.get("type") == "object" and schema.get("default") == {}
+
+
+def _schema_at(schema: dict, keys: list[str]) -> dict | None:
+    """The schema of the value at ``keys`` (through ``properties`` and mapping ``additionalProperties``)."""
+    for key in keys:
+        extra = schema.get("additionalProperties")
+        sub = schema.get("properties", {}).get(key, extra if isinstance(extra, dict) else None)
+        if not isinstance(sub, dict):
+            return None
+        schema = sub
+    return schema
+
+
 def _null_clears_a_mapping(node: dict, schema: dict) -> None:
     """``key: null`` where the schema wants a mapping with a default reads as that default (``{}``).
 
@@ -142,15 +160,16 @@ def _null_clears_a_mapping(node: dict, schema: dict) -> None:
         sub = props.get(key, extra if isinstance(extra, dict) else None)
         if not isinstance(sub, dict):
             continue
-        if value is None and sub.get("type") == "object" and isinstance(sub.get("default"), dict):
-            node[key] = dict(sub["default"])
+        if value is None and _clearable(sub):
+            node[key] = {}
         elif isinstance(value, dict):
             _null_clears_a_mapping(value, sub)
 
 
-def _empty_overlay_mappings(sources: list[str | Path], config: dict) -> None:
-    """Refuse an overlay's empty mapping over a non-empty one: it merges into nothing, so the run
-    would keep what the user meant to clear (the studies' effects, say) and say nothing."""
+def _empty_overlay_mappings(sources: list[str | Path], config: dict, schema: dict) -> None:
+    """Refuse an overlay's empty mapping over a non-empty one where null would clear it: it merges
+    into nothing, so the run would keep what the user meant to clear (the studies' effects, say)
+    and say nothing. Elsewhere (``doe: {}``, say) an empty mapping changes nothing and harms nothing."""
     for path in sources[1:]:
         try:
             overlay = yaml.safe_load(Path(path).read_text())
@@ -160,7 +179,7 @@ def _empty_overlay_mappings(sources: list[str | Path], config: dict) -> None:
             merged = config
             for key in field.split("."):
                 merged = merged.get(key) if isinstance(merged, dict) else None
-            if isinstance(merged, dict) and merged:
+            if isinstance(merged, dict) and merged and _clearable(_schema_at(schema, field.split("."))):
                 raise ConfigError(path, "an empty mapping in an overlay merges into the base's and clears nothing "
                                         f"(it keeps {', '.join(map(str, merged))}): write null to clear it",
                                   field=field, value={})
@@ -210,7 +229,8 @@ def _unexpected_keys(error: jsonschema.ValidationError) -> list[str]:
         return []
     known = set(error.schema.get("properties", {}))
     patterns = [re.compile(p) for p in error.schema.get("patternProperties", {})]
-    return sorted(k for k in error.instance if k not in known and not any(p.search(k) for p in patterns))
+    return sorted(str(k) for k in error.instance
+                  if k not in known and not any(p.search(str(k)) for p in patterns))
 
 
 def _and_the_others(problems: list[str], shown: int = 10) -> str:

@@ -261,6 +261,29 @@ def test_an_output_that_cannot_be_written_is_an_input_error_not_a_traceback(tmp_
     rc = main(["paper-measurements", "--unit", "hd42", "--data", str(DATA), "--out", str(out)])
     err = capsys.readouterr().err.strip()
     assert rc == 2 and err.startswith(f"hdwf: error: {out}, field '--out': cannot be written: ") and not out.exists()
+    assert err.endswith("(/proc/hdwf-test)")   # the path the system refused, not only its reason
+
+
+def test_an_output_folder_without_write_permission_is_refused_before_the_work(tmp_path, capsys, monkeypatch):
+    """Root may write anywhere, so the check is made to see a folder it may not write in."""
+    import hdwf.cli as cli
+
+    monkeypatch.setattr(cli.os, "access", lambda path, mode: False)
+    out = tmp_path / "m.csv"
+    rc = main(["paper-measurements", "--unit", "hd42", "--data", str(DATA), "--out", str(out)])
+    assert rc == 2 and not out.exists()
+    assert capsys.readouterr().err.strip() == (f"hdwf: error: {out}, field '--out': cannot be written: "
+                                               f"no permission to write in {tmp_path}")
+
+
+def test_a_dangling_link_at_out_is_an_existing_output(tmp_path, capsys):
+    """A symbolic link to nowhere is not "absent": it is kept without --force (before, the
+    command solved everything and ended in a FileExistsError traceback)."""
+    out = tmp_path / "m.csv"
+    out.symlink_to(tmp_path / "gone" / "m.csv")
+    rc = main(["paper-measurements", "--unit", "hd42", "--data", str(DATA), "--out", str(out)])
+    assert rc == 2 and out.is_symlink()
+    assert "field '--out': exists; measurement files are never overwritten" in capsys.readouterr().err
 
 
 def test_paper_measurements_keeps_a_file_made_at_out_while_it_ran(tmp_path, capsys, monkeypatch):
@@ -298,8 +321,9 @@ def test_a_config_and_its_overlay_merge_key_by_key_and_a_bad_key_is_blamed_on_it
     assert str(exc.value).startswith(f"{overlay}, field 'fe.steps_per_ramp', value 0:")
 
 
-@pytest.mark.parametrize("text, field, unexpected", [("sobl:\n  x: 1\n", "sobl", "sobl"),
-                                                     ("doe:\n  n_design: 3\n", "doe.n_design", "n_design")])
+@pytest.mark.parametrize("text, field, unexpected", [("sobl:\n  x: 1\n", "sobl", "'sobl'"),
+                                                     ("doe:\n  n_design: 3\n", "doe.n_design", "'n_design'"),
+                                                     ("fe:\n  7: 3\n", "fe.7", "7")])
 def test_an_unknown_key_of_an_overlay_is_blamed_on_the_overlay_by_its_full_name(tmp_path, text, field, unexpected):
     """A misspelt top-level key of an overlay was blamed on '--config (command line)', which the
     user never gave, as field '(top level)'; the field is now the key itself, in the overlay."""
@@ -308,7 +332,7 @@ def test_an_unknown_key_of_an_overlay_is_blamed_on_the_overlay_by_its_full_name(
     with pytest.raises(ConfigError) as exc:
         load_config([ROOT / "config.yaml", overlay], SCHEMA)
     assert str(exc.value).startswith(f"{overlay}, field '{field}': Additional properties are not allowed "
-                                     f"('{unexpected}' was unexpected)")
+                                     f"({unexpected} was unexpected)")
 
 
 def test_an_overlay_clears_the_studies_effects_with_null_and_an_empty_mapping_is_refused(tmp_path):
@@ -327,6 +351,8 @@ def test_an_overlay_clears_the_studies_effects_with_null_and_an_empty_mapping_is
     assert str(exc.value).endswith("write null to clear it")
     overlay.write_text("validation:\n  demo:\n    effects: {}\n")   # empty over empty: nothing to clear
     assert load_config([ROOT / "config.yaml", overlay], SCHEMA)["validation"]["demo"]["effects"] == {}
+    overlay.write_text("doe: {}\n")   # null would not clear doe (no {} default): {} there is harmless, not refused
+    assert load_config([ROOT / "config.yaml", overlay], SCHEMA)["doe"] == base["doe"]
 
 
 def test_an_empty_config_file_is_refused_as_snakemake_refuses_it(tmp_path):

@@ -12,7 +12,8 @@ ARCMIN = math.pi / (180 * 60)
 
 
 def test_the_catalogue_holds_the_published_k1_and_t1():
-    """Harmonic Drive CSF, ratio 50 (background.md, section 2): K1 in 10^4 N m/rad below T1."""
+    """Harmonic Drive CSF, ratio 50, K1 in 10^4 N m/rad below T1: the brief's background notes give
+    sizes 17, 32 and 50 with their T1 in its catalogue section and size 45 beside the paper's fits."""
     published = {17: (0.81, 3.9), 32: (5.4, 29.0), 45: (15.0, 76.0), 50: (20.0, 108.0)}
     assert {u.size: (u.k1_Nm_per_rad / 1e4, u.t1_Nm) for u in CATALOGUE} == published
     assert [u.size for u in catalogue_units("hd42")] == [17] and [u.size for u in catalogue_units("hd120")] == [45, 50]
@@ -54,3 +55,11 @@ def test_the_catalogue_follows_the_size_law_and_a_model_is_held_against_it():
 def test_what_the_catalogue_cannot_judge_is_refused(unit, torque, values, said):
     with pytest.raises(ValueError, match=said):
         catalogue_check(unit, torque, values)
+
+
+def test_a_drive_between_two_units_gives_its_ratio_low_end_against_the_softer_unit():
+    """HD 120 between CSF-50 (2T/K1 0.727 arcmin) and CSF-45 (0.970): a median of 0.5 arcmin is
+    0.5/0.970 = 0.515 of the softer unit's and 0.5/0.727 = 0.687 of the stiffer's, printed low first."""
+    check = catalogue_check("hd120", 21.16, {"ours": [0.4, 0.5, 0.6]})
+    assert check.ratio("ours") == pytest.approx((0.5 / 0.96990, 0.5 / 0.72743), rel=1e-4)
+    assert check.stiffness_Nm_per_rad("ours") == pytest.approx(2 * 21.16 / (0.5 * ARCMIN), rel=1e-12)

@@ -9,7 +9,7 @@ from hdwf.drive.geometry import unit_data
 from hdwf.report.agreement_part import drive_role
 from hdwf.report.artefacts import FeSettings, StudyArtefacts
 from hdwf.report.document import UNIT_NAMES, Document, fmt
-from hdwf.study.catalogue import CatalogueCheck, catalogue_check, catalogue_units, size_ratio
+from hdwf.study.catalogue import LIMITS, CatalogueCheck, catalogue_check, catalogue_units, size_ratio
 
 
 def _lost_motion(study: StudyArtefacts, unit: str) -> pd.Series:
@@ -61,7 +61,8 @@ def catalogue_section(doc: Document, units: list[str], paper: StudyArtefacts, fe
               "CSF, ratio 50; ±T lies below $T_1$), against the median $Phi$ of each set of designs.")
     text = ("A catalogue unit is measured whole, cup, diaphragm, bearing and teeth, by its maker: no model of ours "
             "or the paper's made these numbers. Its backlash and hysteresis (of the order of an arcminute at $T_N$) "
-            "are left out here, so $2T slash K_1$ is the part a frictionless model should give.")
+            "are left out here, so $2T slash K_1$ is the part a frictionless model should give. It is held fixed "
+            f"only so far: {LIMITS}.")
     if "hd42" in checks and "hd120" in checks:
         small, large = checks["hd42"], checks["hd120"]
         c_lo, c_hi = size_ratio(small, large)
@@ -88,6 +89,6 @@ def _blind_sentence(small: CatalogueCheck, large: CatalogueCheck, settings: FeSe
     blind = UNIT_NAMES["hd120" if settings.calibrated_on == "hd42" else "hd42"]
     return (f" The paper's two drives lie {fmt(away['paper'], 2)}× off the catalogue's ratio, ours at most "
             f"{fmt(max(away[n] for n in ours), 2)}×: calibrated on the {UNIT_NAMES[settings.calibrated_on]} table, our "
-            f"model carries that calibration to {blind} nearly by the size law, which the paper's two tables do not "
-            "keep; so part of the blind drive's miss of the paper's level is the paper's own departure from that law "
+            f"model carries that calibration to {blind} closer to the size law than the paper's two tables keep it; "
+            "so part of the blind drive's miss of the paper's level is the paper's own departure from that law "
             "(the table gives each level against the real unit).")

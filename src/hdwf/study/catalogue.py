@@ -7,6 +7,11 @@ a check against the world that no FE model of ours or the paper's made: a whole 
 diaphragm, bearing, teeth) measured by its maker. HD 42 compares with the CSF size 17, HD 120 lies
 between sizes 45 and 50 (``COMPARABLE_SIZES``; docs/fe-model.md, "Against makers' catalogues").
 
+Two limits, in opposite directions (``LIMITS``): the values are for ratio 50, our drives are ratio
+120, and K1 rises with the ratio (HFUC-32-100's 6.7·10⁴ against CSF-32-50's 5.4·10⁴ N·m/rad, 24 %),
+so a ratio-120 unit's 2T/K1 is likely lower; and K1 is the mean slope from 0 to T1, while ±T is a
+quarter of T1, where a real curve is softer, so its 2T/K there is likely higher.
+
 Torque and stiffness both scale with the size cubed, so drives of one series show lost motion of
 the same order in arcmin: the catalogue's two Φ stand in that ratio, which ``size_ratio`` compares
 with the ratio of a model's two levels.
@@ -33,13 +38,20 @@ class CatalogueUnit:
     t1_Nm: float
 
 
-#: Harmonic Drive CSF series, ratio 50 (background.md, "Reference values from makers' catalogues")
+#: Harmonic Drive CSF series, ratio 50, as gathered for this project from the maker's catalogue
+#: (sizes 17, 32, 50 with their T1 in one table, size 45 beside the paper's fits)
 CATALOGUE = (
     CatalogueUnit("CSF", 17, 50, 0.81e4, 3.9),
     CatalogueUnit("CSF", 32, 50, 5.4e4, 29.0),
     CatalogueUnit("CSF", 45, 50, 15e4, 76.0),
     CatalogueUnit("CSF", 50, 50, 20e4, 108.0),
 )
+
+#: what the comparison cannot hold fixed, for the report to say beside it
+LIMITS = ("the catalogue's K1 is for ratio 50 and our drives are ratio 120: a higher ratio is stiffer "
+          "(24 % for size 32 at ratio 100), so a ratio-120 unit's 2T/K1 is likely lower; K1 is the mean slope "
+          "from 0 to T1 and ±T is about a quarter of T1, where a real curve is softer, so its 2T/K there is "
+          "likely higher")
 
 #: the catalogue sizes each drive compares with (HD 120 lies between two)
 COMPARABLE_SIZES = {"hd42": (17,), "hd120": (45, 50)}
