@@ -80,7 +80,7 @@ def test_synth_shows_progress_and_writes_the_test_cycle(tmp_path, capsys):
                "--steps-per-ramp", "2", "--out", str(out)])
     err = capsys.readouterr().err
     assert rc == 0, err
-    assert "hd42: 2 solves" in err and "2/2" in err  # the bar reached the last specimen
+    assert "hd42: 2 specimens, 2 solves" in err and "2/2" in err  # the bar reached the last specimen
     data = pd.read_csv(out)
     # 0 -> +T -> 0 -> -T -> 0 at 2 steps per ramp: 4 x 2 + 1 points per specimen
     assert data.groupby("specimen_id").size().tolist() == [9, 9]
