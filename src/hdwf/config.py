@@ -62,9 +62,10 @@ def validate_config(config: dict, schema_path: str | Path = SCHEMA_PATH,
         blamed on the last file that sets the offending key, or on ``--config`` if none does.
     """
     sources = [source] if isinstance(source, (str, Path)) else list(source)
-    _null_clears_a_mapping(config, _schema(str(schema_path)))
+    schema = _schema(str(schema_path))
+    _null_clears_a_mapping(config, schema)
     try:
-        _empty_overlay_mappings(sources, config, _schema(str(schema_path)))
+        _empty_overlay_mappings(sources, config, schema)
         _check_schema(config, schema_path, sources[-1])
         _check_relations(config, sources[-1])
     except ConfigError as exc:
@@ -154,11 +155,9 @@ def _null_clears_a_mapping(node: dict, schema: dict) -> None:
     Overlays merge mapping into mapping, so an overlay's ``fe: {effects: {}}`` changes nothing;
     ``effects: null`` replaces the base's mapping, and this turns it into the empty one.
     """
-    props = schema.get("properties", {})
-    extra = schema.get("additionalProperties")
     for key, value in node.items():
-        sub = props.get(key, extra if isinstance(extra, dict) else None)
-        if not isinstance(sub, dict):
+        sub = _schema_at(schema, [key])
+        if sub is None:
             continue
         if value is None and _clearable(sub):
             node[key] = {}
