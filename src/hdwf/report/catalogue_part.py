@@ -17,10 +17,13 @@ def _lost_motion(study: StudyArtefacts, unit: str) -> pd.Series:
     return table["lost_motion_arcmin"]
 
 
+def span_text(lo: float, hi: float, digits: int) -> str:
+    """``lo–hi``, or one number where the two print alike (a drive compared with one unit)."""
+    return fmt(lo, digits) if f"{lo:.{digits}f}" == f"{hi:.{digits}f}" else f"{fmt(lo, digits)}–{fmt(hi, digits)}"
+
+
 def _with_ratio(check: CatalogueCheck, name: str) -> str:
-    lo, hi = check.ratio(name)
-    span = fmt(lo, 2) if f"{lo:.2f}" == f"{hi:.2f}" else f"{fmt(lo, 2)}–{fmt(hi, 2)}"
-    return f"{fmt(check.levels_arcmin[name], 3)} ({span}×)"
+    return f"{fmt(check.levels_arcmin[name], 3)} ({span_text(*check.ratio(name), 2)}×)"
 
 
 def catalogue_checks(units: list[str], paper: StudyArtefacts, fe_studies: list[StudyArtefacts]
@@ -36,9 +39,8 @@ def catalogue_checks(units: list[str], paper: StudyArtefacts, fe_studies: list[S
 
 def catalogue_phi_text(check: CatalogueCheck) -> str:
     """The compared units and their 2T/K1, e.g. ``CSF-17: 0.815 arcmin``."""
-    lo, hi = check.catalogue_phi_arcmin
     units = " and ".join(f"CSF-{size}" for size in check.sizes)
-    return f"{units}: {fmt(lo, 3)} arcmin" if len(check.sizes) == 1 else f"{units}: {fmt(lo, 3)}–{fmt(hi, 3)} arcmin"
+    return f"{units}: {span_text(*check.catalogue_phi_arcmin, 3)} arcmin"
 
 
 def catalogue_section(doc: Document, units: list[str], paper: StudyArtefacts, fe_studies: list[StudyArtefacts],
@@ -49,11 +51,9 @@ def catalogue_section(doc: Document, units: list[str], paper: StudyArtefacts, fe
     checks, rows = catalogue_checks(units, paper, fe_studies), []
     for u in units:
         check = checks[u]
-        cat = catalogue_units(u)
-        lo, hi = check.catalogue_phi_arcmin
         rows.append([UNIT_NAMES[u] + drive_role(settings, u),
-                     ", ".join(f"{c.series}-{c.size}: {c.k1_Nm_per_rad / 1e4:g}" for c in cat),
-                     fmt(lo, 3) if len(cat) == 1 else f"{fmt(lo, 3)}–{fmt(hi, 3)}",
+                     ", ".join(f"{c.series}-{c.size}: {c.k1_Nm_per_rad / 1e4:g}" for c in catalogue_units(u)),
+                     span_text(*check.catalogue_phi_arcmin, 3),
                      *(_with_ratio(check, name) if name in check.levels_arcmin else "–" for name in levels)])
     doc.table(["drive", "catalogue $K_1$ ($10^4$ N·m/rad)", "catalogue $2T slash K_1$",
                *(f"median $Phi$, {label} (over the catalogue's)" for label in levels.values())], rows,

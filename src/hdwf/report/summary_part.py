@@ -12,7 +12,7 @@ import pandas as pd
 from hdwf.common.io import read_json
 from hdwf.report.agreement_part import AGREEMENT_TARGETS, TARGET_BOUNDS, drive_role, paper_agreement
 from hdwf.report.artefacts import ReportInputs
-from hdwf.report.catalogue_part import catalogue_checks, catalogue_phi_text
+from hdwf.report.catalogue_part import catalogue_checks, catalogue_phi_text, span_text
 from hdwf.report.document import UNIT_NAMES, Document, fmt, lit
 from hdwf.report.paper_part import largest_sobol_difference
 
@@ -74,11 +74,9 @@ def _fe_model(report: ReportInputs) -> list[Finding]:
                   Finding(f"{name}: $d Phi slash d r_\"FS\"$, ours over the paper's", f"{fmt(pa.slope_ratio, 2)}×",
                           f"[{s_lo}, {s_hi:g}]×", where, _meets("slope_ratio", pa.slope_ratio))]
         check = catalogue_checks([unit], paper, [ours])[unit]
-        ours_lo, ours_hi = check.ratio(ours.name)
-        paper_lo, paper_hi = check.ratio("paper")
-        span = (lambda lo, hi: fmt(lo, 2) + "×" if f"{lo:.2f}" == f"{hi:.2f}" else f"{fmt(lo, 2)}–{fmt(hi, 2)}×")
         found.append(Finding(f"{name}: median $Phi$ over a catalogue unit's $2T slash K_1$ (the paper's in brackets)",
-                             f"{span(ours_lo, ours_hi)} ({span(paper_lo, paper_hi)})", catalogue_phi_text(check),
+                             f"{span_text(*check.ratio(ours.name), 2)}× ({span_text(*check.ratio('paper'), 2)}×)",
+                             catalogue_phi_text(check),
                              "Part II, Against makers' catalogues"))
     return found
 

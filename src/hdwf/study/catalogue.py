@@ -19,12 +19,11 @@ with the ratio of a model's two levels.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
-ARCMIN_PER_RAD = 180.0 * 60.0 / math.pi
+from hdwf.drive.geometry import ARCMIN   # rad per arcmin
 
 
 @dataclass(frozen=True)
@@ -87,7 +86,7 @@ class CatalogueCheck:
 
     def stiffness_Nm_per_rad(self, name: str) -> float:
         """The secant stiffness of the test, 2 T / Φ, that level ``name`` means."""
-        return 2.0 * self.torque_Nm / (self.levels_arcmin[name] / ARCMIN_PER_RAD)
+        return 2.0 * self.torque_Nm / (self.levels_arcmin[name] * ARCMIN)
 
 
 def catalogue_check(unit: str, torque_Nm: float, levels_arcmin: dict[str, np.ndarray]) -> CatalogueCheck:
@@ -101,7 +100,7 @@ def catalogue_check(unit: str, torque_Nm: float, levels_arcmin: dict[str, np.nda
     if beyond:
         raise ValueError(f"{unit}: the test torque {torque_Nm:g} N·m is not below T1 of size "
                          f"{', '.join(str(u.size) for u in beyond)}: K1 is not the slope there")
-    phi = sorted(2.0 * torque_Nm / u.k1_Nm_per_rad * ARCMIN_PER_RAD for u in units)
+    phi = sorted(2.0 * torque_Nm / u.k1_Nm_per_rad / ARCMIN for u in units)
     levels = {}
     for name, values in levels_arcmin.items():
         finite = np.asarray(values, float)
