@@ -189,7 +189,7 @@ def test_anchoring_on_actual_solves_removes_the_tables_interpolation_error():
     assert log["thermal"].solved_at == pytest.approx([lo, (lo + hi) / 2, hi])
 
 
-def test_the_effect_found_in_the_last_round_is_anchored_for_the_final_model():
+def test_the_effect_found_in_the_last_round_is_anchored_for_the_final_model(caplog):
     """A search of one round finds thermal on the table's spline (0.19 K off the true 17 K
     between the kinks) and has no further round to anchor it before. The final model is
     anchored all the same (one solve of three values), so the estimate the ladder re-solves is
@@ -199,8 +199,15 @@ def test_the_effect_found_in_the_last_round_is_anchored_for_the_final_model():
     data = CalibrationData(twist({"thermal": {"delta_T_K": 17.0}}), twist({}), resp)
     specimen = obs["specimen_id"].to_numpy()
     search = _GreedySearch(data, specimen, Search(max_rounds=1), Resolver(solve, obs, {}, dict(resp)))
-    search.run(["thermal"])
+    with caplog.at_level("INFO", logger="hdwf.validation.diagnosis"):
+        search.run(["thermal"])
     assert search.on == ["thermal"] and calls == [3]
+    # the job's log tells the search as it went: the round's decision, then the final re-solve
+    # with the value it gave (the rule's log held nothing but scikit-fem's assembly lines)
+    round_line, final_line = [r.getMessage() for r in caplog.records]
+    assert round_line.startswith("round 1 on the campaign's model") and "thermal is missing" in round_line
+    assert final_line.startswith("for the final model, thermal: anchored (delta_T_K solved at 15.858, ")
+    assert final_line.endswith("now {'delta_T_K': %r}" % float(search.fit.t[0]))
     assert search.fit.t[0] == pytest.approx(17.0, abs=1e-6)
     assert search.refinement == {}                    # no round came after the first
     log = search.final_refinement["thermal"].as_dict()

@@ -18,6 +18,8 @@ def setup(snakemake):
     """
     logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, force=True,
                         format="%(asctime)s %(levelname)s %(message)s")
+    # scikit-fem logs every assembly at INFO: four lines a body, thousands in a campaign's log
+    logging.getLogger("skfem").setLevel(logging.WARNING)
     return provenance(snakemake.config, PROJECT_ROOT)
 
 

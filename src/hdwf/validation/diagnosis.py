@@ -26,6 +26,7 @@ Method (see docs/validation.md; calibration in ``hdwf.validation.calibration``):
 
 from __future__ import annotations
 
+import logging
 import math
 from dataclasses import asdict, dataclass, field
 from typing import Callable
@@ -43,6 +44,8 @@ from hdwf.validation.observations import observation_frame, predict, prediction_
 from hdwf.validation.noise import NoiseCheck
 from hdwf.validation.signature import ResidualSignature, residual_signature, with_verdict
 from hdwf.validation.variants import candidate_names, variant_key
+
+log = logging.getLogger(__name__)
 
 
 # a candidate takes out a component of the residual when it leaves at most this share of it
@@ -230,8 +233,15 @@ class _GreedySearch:
         """With a solver, recalibrate the switched-on effects on actual solves near their
         estimates: before round ``before_round``, or for the final model (None)."""
         if self.resolver is not None:
-            log = self.refinement if before_round is not None else self.final_refinement
-            self.fit = refine_fit(self.data, self.fit, self.resolver, log, before_round)
+            where = self.refinement if before_round is not None else self.final_refinement
+            self.fit = refine_fit(self.data, self.fit, self.resolver, where, before_round)
+            when = f"before round {before_round}" if before_round is not None else "for the final model"
+            for effect, entry in where.items():
+                if entry.before_round == before_round:
+                    at = ", ".join(f"{v:.5g}" for v in entry.solved_at or [])
+                    log.info("%s, %s: %s%s; now %s", when, effect, entry.status,
+                             f" ({entry.param} solved at {at})" if at else f" ({entry.reason})",
+                             self.fit.params(self.data.resp).get(effect))
 
     def calibrate_first(self, effects: list[str]) -> None:
         """Switch ``effects`` on and calibrate them before the search (recalibrated on solves)."""
@@ -257,6 +267,9 @@ class _GreedySearch:
         takes_out = {e: self.takes_out(fit.S, f.S) for e, f in fits.items()} if self.takes_out else None
         v = verdict(cur, cands, self.search.pay_threshold, self.search.tie_threshold, takes_out)
         self.rounds.append(Round(number, list(on), cur.rmse, v, evidence))
+        log.info("round %d on %s (RMSE %.4f arcmin): %s; ranked %s", number, list(on) or "the campaign's model",
+                 cur.rmse, v.text, ", ".join(f"{r.effect} ΔBIC {r.delta_bic:.1f} RMSE {r.rmse_arcmin:.4f}"
+                                             for r in v.ranking))
         return fits
 
     def run(self, candidates: list[str]) -> None:
