@@ -13,6 +13,9 @@ STUDIES = config["studies"]
 PAPER_STUDIES = [s for s, v in STUDIES.items() if v["source"] == "paper"]
 FE_STUDIES = [s for s, v in STUDIES.items() if v["source"] == "fe"]
 FE = config["fe"]
+# how the FE studies mesh a section (MeshSettings); the convergence runs change the refinement only
+FE_MESH = {k: FE[k] for k in ("elements_over_height", "elements_over_thickness", "refinement", "symmetry",
+                              "flank_refinement")}
 CAMPAIGNS = {name: campaign_plan(name, c, FE) for name, c in config.get("validation", {}).items()}
 
 

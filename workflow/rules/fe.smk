@@ -27,7 +27,7 @@ rule fe_solve:
         row="results/{study}/{unit}/designs/{design}.parquet",
         curve="results/{study}/{unit}/designs/{design}_curve.parquet",
     params:
-        settings={k: FE[k] for k in ("elements_over_height", "elements_over_thickness", "refinement", "symmetry")},
+        settings=FE_MESH,
         steps_per_ramp=FE["steps_per_ramp"],
         effects=FE["effects"],
     threads: 1
@@ -75,9 +75,7 @@ rule fe_refined_solve:
     output:
         "results/{study}/{unit}/convergence/r{ref}/{design}.parquet",
     params:
-        settings=lambda w: {"elements_over_height": FE["elements_over_height"],
-                            "elements_over_thickness": FE["elements_over_thickness"], "refinement": float(w.ref),
-                            "symmetry": FE["symmetry"]},
+        settings=lambda w: {**FE_MESH, "refinement": float(w.ref)},
         steps_per_ramp=FE["steps_per_ramp"],
         effects=FE["effects"],
     threads: 1
@@ -118,7 +116,7 @@ rule fe_deformed:
                    category="{study}", subcategory="{unit}"),
         fields="results/{study}/{unit}/deformed_{design}.npz",
     params:
-        settings={k: FE[k] for k in ("elements_over_height", "elements_over_thickness", "refinement", "symmetry")},
+        settings=FE_MESH,
         steps_per_ramp=FE["steps_per_ramp"],
         effects=FE["effects"],
     threads: 1
