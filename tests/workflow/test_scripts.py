@@ -68,3 +68,37 @@ def test_the_snakefile_starts_jobs_with_freed_memory_kept(env, expected, tmp_pat
                          capture_output=True, text=True, timeout=120)
     assert run.returncode == 0, run.stderr[-3000:]
     assert run.stdout.strip().splitlines()[-1] == expected
+
+
+_MESH_PARAMS = """
+import json, sys
+from pathlib import Path
+from types import SimpleNamespace
+from snakemake.api import SnakemakeApi
+from snakemake.settings.types import ConfigSettings, OutputSettings, ResourceSettings
+root = Path(sys.argv[1])
+with SnakemakeApi(OutputSettings(quiet={"all"})) as api:
+    wf = api.workflow(resource_settings=ResourceSettings(cores=1), snakefile=root / "Snakefile", workdir=root,
+                      config_settings=ConfigSettings(configfiles=[root / sys.argv[2]]))
+    wf.dag()
+    rules = wf._workflow
+    solve = dict(rules.get_rule("fe_solve").params.items())["settings"]
+    refined = dict(rules.get_rule("fe_refined_solve").params.items())["settings"](SimpleNamespace(ref="1.25"))
+print(json.dumps([solve, refined]))
+"""
+
+
+def test_the_flank_division_of_the_config_reaches_every_study_mesh(tmp_path):
+    """`fe.flank_refinement` (workflow/overlays/fine_flanks.yaml) must reach the study's solves
+    and its convergence runs alike: were it lost on either, the 1.25x check would compare two
+    different flank divisions (25 against 12 segments) and call it a mesh's convergence."""
+    import json
+
+    copy_workflow(tmp_path)
+    run = subprocess.run([sys.executable, "-c", _MESH_PARAMS, str(tmp_path), "workflow/overlays/fine_flanks.yaml"],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr[-3000:]
+    solve, refined = json.loads(run.stdout.strip().splitlines()[-1])
+    assert solve == {"elements_over_height": 10, "elements_over_thickness": 6, "refinement": 1.0,
+                     "symmetry": "half", "flank_refinement": 2.5}
+    assert refined == {**solve, "refinement": 1.25}
