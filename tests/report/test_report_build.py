@@ -736,3 +736,21 @@ def test_catalogue_section_says_when_the_papers_drives_leave_the_size_law_and_ou
     far = catalogue_check("hd120", 21.16, {"paper": [1.244], "fe": [2.0]})
     assert _blind_sentence(small, far, settings) == ""
     assert _blind_sentence(small, large, FeSettings(MeshSettings(), 5)) == ""
+
+
+@pytest.mark.parametrize("flank_refinement, said", [(1.0, None), (2.5, "(25 a flank, `fe.flank_refinement`)")])
+def test_the_fe_section_names_a_finer_flank_division(flank_refinement, said):
+    """A report of the fine_flanks overlay must say its flanks were divided 2.5 times finer, or its
+    convergence table reads as the paper's 10 x 6 rule; the default's text stays as it was."""
+    from hdwf.drive.design import MeshSettings
+    from hdwf.report.artefacts import FeSettings
+    from hdwf.report.fe_part import fe_model_section
+
+    doc = Document("t", "s", PROVENANCE)
+    fe_model_section(doc, (), {}, FeSettings(MeshSettings(flank_refinement=flank_refinement), 5))
+    settings_text = next(b["text"] for b in doc.blocks if b.get("text", "").startswith("Settings:"))
+    assert settings_text.startswith("Settings: 10 elements over the tooth height and 6 over its thickness "
+                                    "(the paper's rule) times a refinement of 1")
+    assert ("a flank" in settings_text) == (said is not None)
+    if said:
+        assert "every flank divided into 2.5 times as many segments " + said in settings_text
