@@ -13,7 +13,7 @@ import pyarrow.parquet as pq
 
 from hdwf import PARAMETER_COLUMNS
 from hdwf.drive.geometry import DriveGeometry, drive_geometry
-from hdwf.drive.mesh import BODY_NAMES, DriveMesh, build_mesh
+from hdwf.drive.mesh import BODY_NAMES, DriveMesh, build_mesh, flank_segments
 
 
 @dataclass(frozen=True)
@@ -41,6 +41,11 @@ class MeshSettings:
 
     def as_dict(self) -> dict:
         return asdict(self)
+
+    @property
+    def segments_per_flank(self) -> int:
+        """The segments along every flank of this mesh."""
+        return flank_segments(self.elements_over_height, self.refinement, self.flank_refinement)
 
     def mesh(self, geom: DriveGeometry, path: str | None = None, bodies: tuple[str, ...] = BODY_NAMES) -> DriveMesh:
         """Mesh ``geom`` (its ``bodies``); with ``path`` gmsh also writes its ``.msh`` there."""

@@ -80,6 +80,11 @@ class DriveMesh:
         return sum(b.mesh.p.shape[1] for b in self.bodies.values())
 
 
+def flank_segments(n_h: int, refinement: float = 1.0, flank_refinement: float = 1.0) -> int:
+    """The segments along every flank of a mesh of these settings (``build_mesh``)."""
+    return max(2, int(round(max(2, int(round(n_h * refinement))) * flank_refinement)))
+
+
 def _sizes(g: DriveGeometry, n_h: int, n_t: int, refinement: float,
            flank_refinement: float = 1.0) -> dict[str, float]:
     h_tooth = g.r_fs_tip - g.r_fs_root
@@ -88,7 +93,7 @@ def _sizes(g: DriveGeometry, n_h: int, n_t: int, refinement: float,
     nt = max(2, int(round(n_t * refinement)))
     s = min(h_tooth / nh, s_pitch / nt)
     return dict(
-        n_flank=max(2, int(round(nh * flank_refinement))),
+        n_flank=flank_segments(n_h, refinement, flank_refinement),
         tooth=s,
         fs_bore=2.0 * s,
         cs_outer=max(4.0 * s, (g.r_cs_outer - g.r_cs_root) / max(3.0, 4 * refinement)),
