@@ -80,17 +80,20 @@ class DriveMesh:
         return sum(b.mesh.p.shape[1] for b in self.bodies.values())
 
 
+def _count(n: float) -> int:
+    return max(2, int(round(n)))
+
+
 def flank_segments(n_h: int, refinement: float = 1.0, flank_refinement: float = 1.0) -> int:
     """The segments along every flank of a mesh of these settings (``build_mesh``)."""
-    return max(2, int(round(max(2, int(round(n_h * refinement))) * flank_refinement)))
+    return _count(_count(n_h * refinement) * flank_refinement)
 
 
 def _sizes(g: DriveGeometry, n_h: int, n_t: int, refinement: float,
            flank_refinement: float = 1.0) -> dict[str, float]:
     h_tooth = g.r_fs_tip - g.r_fs_root
     s_pitch = math.pi * g.module / 2
-    nh = max(2, int(round(n_h * refinement)))
-    nt = max(2, int(round(n_t * refinement)))
+    nh, nt = _count(n_h * refinement), _count(n_t * refinement)
     s = min(h_tooth / nh, s_pitch / nt)
     return dict(
         n_flank=flank_segments(n_h, refinement, flank_refinement),

@@ -54,8 +54,7 @@ def fe_model_section(doc: Document, assumptions: tuple[dict, ...], pictures: dic
              f"{mesh.elements_over_thickness} over its thickness (the paper's rule) times a refinement "
              f"of {mesh.refinement:g}"
              + (f", every flank divided into {mesh.flank_refinement:g} times as many segments "
-                f"({mesh.segments_per_flank} a flank, "
-                "`fe.flank_refinement`)"
+                f"({mesh.segments_per_flank} a flank, `fe.flank_refinement`)"
                 if mesh.flank_refinement != 1 else "")
              + f"; {settings.steps_per_ramp} load steps per ramp; "
              + ("the half model (angles 0 to π tied by the drive's 180° point symmetry, which reproduces the "
