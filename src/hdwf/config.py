@@ -296,6 +296,7 @@ def _campaign_problems(name: str, camp: dict, source) -> Iterator[ConfigError]:
     known = registry()
     where = f"validation.{name}"
     yield from _effect_problems(where, camp.get("effects", {}), source)
+    yield from _effect_problems(where, camp.get("hidden_effects", {}), source, key="hidden_effects")
     cands = camp.get("candidates", "all")
     if cands != "all":
         for c in cands:
@@ -304,29 +305,29 @@ def _campaign_problems(name: str, camp: dict, source) -> Iterator[ConfigError]:
                                   value=c)
 
 
-def _effect_problems(where: str, effects: dict, source) -> Iterator[ConfigError]:
-    """Switched-on effects ``{name: {parameter: value | calibrate}}`` under ``where`` against the registry."""
+def _effect_problems(where: str, effects: dict, source, key: str = "effects") -> Iterator[ConfigError]:
+    """Effects ``{name: {parameter: value | calibrate}}`` at ``where.key`` against the registry."""
     known = registry()
     for eff, params in effects.items():
         if eff not in known:
-            yield ConfigError(source, f"unknown effect; known: {', '.join(known)}", field=f"{where}.effects",
+            yield ConfigError(source, f"unknown effect; known: {', '.join(known)}", field=f"{where}.{key}",
                               value=eff)
             continue
         names = {p.name for p in known[eff].parameters}
         for pname, value in params.items():
-            key = f"{where}.effects.{eff}.{pname}"
+            field = f"{where}.{key}.{eff}.{pname}"
             if pname not in names:
                 yield ConfigError(source, f"unknown parameter of {eff}; it has {', '.join(sorted(names))}",
-                                  field=key, value=pname)
+                                  field=field, value=pname)
             elif value != "calibrate":
                 try:
-                    known[eff].param(pname).check(value, key)
+                    known[eff].param(pname).check(value, field)
                 except ValueError as exc:
-                    yield ConfigError(source, str(exc).split(": ", 1)[-1], field=key, value=value)
+                    yield ConfigError(source, str(exc).split(": ", 1)[-1], field=field, value=value)
         missing = names - set(params)
         if missing:
             yield ConfigError(source, f"give every parameter of {eff} (missing {', '.join(sorted(missing))})",
-                              field=f"{where}.effects.{eff}")
+                              field=f"{where}.{key}.{eff}")
 
 
 def _read_yaml(path: Path) -> dict:

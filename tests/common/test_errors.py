@@ -388,3 +388,17 @@ def test_paper_measurements_outside_the_project_says_where_the_tables_are(tmp_pa
     assert rc == 2 and not (tmp_path / "t4.csv").exists()
     assert capsys.readouterr().err.strip() == ("hdwf: error: data/paper, field '--data': no such folder: run this in the "
                                                "project folder, or give --data the folder of the paper's tables")
+
+
+@pytest.mark.parametrize("hidden, field, value", [
+    ({"thermo": {"delta_T_K": 12}}, "validation.demo.hidden_effects", "thermo"),
+    ({"thermal": {"delta_T": 12}}, "validation.demo.hidden_effects.thermal.delta_T", "delta_T"),
+])
+def test_a_hidden_effect_the_registry_does_not_know_is_refused_with_its_field(hidden, field, value):
+    """The report would hold the finding against an effect no campaign can name: refused at start-up,
+    naming the campaign's field and the bad key."""
+    config = yaml.safe_load((ROOT / "config.yaml").read_text())
+    config["validation"]["demo"]["hidden_effects"] = hidden
+    with pytest.raises(ConfigError) as exc:
+        validate_config(config, SCHEMA, [ROOT / "config.yaml"])
+    assert exc.value.field == field and exc.value.value == value

@@ -175,6 +175,8 @@ def test_validation_campaign_chain(tmp_path):
     config = yaml.safe_load((ws / "config.yaml").read_text())
     config["validation"] = {"tiny": {"unit": "hd42", "measurements": "data/validation/tiny.csv",
                                      "candidates": ["thermal", "oldham_play"], "rounds": 2,
+                                     "hidden_effects": {"thermal": {"delta_T_K": 12},
+                                                        "fs_cup_torsion": {"K_Nm_per_rad": 50000}},
                                      "mesh": {"elements_over_height": 5, "elements_over_thickness": 3}}}
     (ws / "config.yaml").write_text(yaml.safe_dump(config))
     target = "results/validation/tiny/ladder.parquet"
@@ -201,6 +203,14 @@ def test_validation_campaign_chain(tmp_path):
     assert 9.5 <= mid <= 13.0
     assert mid - lo == pytest.approx(1.0) and hi - mid == pytest.approx(1.0)   # a tenth of the 10 K grid
     assert len(diag["rounds"]) == 2
+    # the hidden effects reach diagnosis.json: thermal held against its 12 K in its own sd; cup
+    # torsion, no candidate here, is not named, so the campaign did not recover what was hidden
+    by_effect = {p["effect"]: p for p in diag["recovery"]["parameters"]}
+    thermal, cup = by_effect["thermal"], by_effect["fs_cup_torsion"]
+    found = next(f for f in diag["found"] if f["effect"] == "thermal")
+    assert thermal["found"] == found["params"]["delta_T_K"] and thermal["sd"] == found["param_sd"]
+    assert thermal["off_by_sd"] == pytest.approx((thermal["found"] - 12.0) / thermal["sd"])
+    assert cup["found"] is None and not cup["recovered"] and not diag["recovery"]["all_recovered"]
     ladder = pd.read_parquet(ws / target)
     assert list(ladder["model"]) == ["baseline", "with thermal"]
     assert ladder["rmse_arcmin"].iloc[1] < 0.5 * ladder["rmse_arcmin"].iloc[0]

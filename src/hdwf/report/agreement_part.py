@@ -108,6 +108,23 @@ def paper_agreement(paper: StudyArtefacts, ours: StudyArtefacts, unit: str) -> P
     return PaperAgreement(theirs, mine, both, agreement(both["paper"], both["ours"]), weights, slope_ratio)
 
 
+def mesh_scatter(pa: PaperAgreement, convergence) -> tuple[pd.Series, ScatterBand]:
+    """The drive's measured mesh changes (a ``convergence.parquet``) and the band of ``pa``'s
+    figures under scatter of that size (``hdwf.study.agreement.agreement_under_mesh_scatter``)."""
+    changes = pd.read_parquet(convergence)["rel_change_fine"]
+    return changes, agreement_under_mesh_scatter(pa.both["paper"], pa.both["ours"], changes,
+                                                 slope_weights=pa.slope_weights)
+
+
+def at_risk_note(figure: str, value: float, band: ScatterBand | None) -> str:
+    """' (met in 60.6 % of the mesh-scatter draws)' for a target met in fewer than 95 % of them, else ''."""
+    if band is None or figure not in band.samples:
+        return ""
+    low, high = TARGET_BOUNDS[figure]
+    share = band.share(figure, low, high)
+    return f" (met in {share * 100:.1f} % of the mesh-scatter draws)" if low <= value <= high and share < 0.95 else ""
+
+
 def drive_role(settings: FeSettings | None, unit: str) -> str:
     """' (calibrated)' or ' (blind)' when the FE effects were set on one drive's data, else ''."""
     if not (settings and settings.effects and settings.calibrated_on):
@@ -152,8 +169,7 @@ def agreement_section(doc: Document, units: list[str], paper: StudyArtefacts, ou
         role = drive_role(settings, u)
         band = None
         if mesh_changes and mesh_changes.get(u):
-            changes = pd.read_parquet(mesh_changes[u])["rel_change_fine"]
-            band = agreement_under_mesh_scatter(both["paper"], both["ours"], changes, slope_weights=weights)
+            changes, band = mesh_scatter(pa, mesh_changes[u])
             scatter_rows.append([UNIT_NAMES[u] + role, f"{fmt(changes.abs().median() * 100, 2)} %, {fmt(changes.abs().max() * 100, 1)} %",
                                  *(f"{fmt(lo, 3)}–{fmt(hi, 3)}" for lo, hi in (band.median_ratio, band.spearman, band.r2)),
                                  f"{fmt(slope_ratio, 2)}× ({fmt(band.slope_ratio[0], 2)}–{fmt(band.slope_ratio[1], 2)}×)"])

@@ -75,7 +75,8 @@ def full_report(report: ReportInputs, out) -> Path:
     """
     doc = Document("hdwf: lost motion of harmonic drives", "Paper replication, our FE model and its studies",
                    report.provenance)
-    doc.text("Part I reproduces the statistics of Majchrák et al. from their own FEA tables; Part II solves the same "
+    doc.text("Part I reproduces the statistics of Majchrák et al., _Global Sensitivity Analysis of Chosen "
+             "Harmonic Drive Parameters Affecting Its Lost Motion_, from their own FEA tables; Part II solves the same "
              "lost-motion test with our FE model, at our own optimal Latin hypercube (`fe`) and at the paper's design "
              "points (`fe_at_paper`), and runs the same chain on it; Part III holds the model against measurement "
              "files, finds which physical effect it misses and re-solves it with that effect. Every number below "

@@ -55,6 +55,11 @@ def fmt(x, digits: int = 4) -> str:
     return f"{x:.{digits}f}"
 
 
+def significant(value: float, digits: int = 4) -> str:
+    """``value`` to ``digits`` significant figures, never in exponent notation (a calibrated value)."""
+    return np.format_float_positional(value, precision=digits, unique=False, fractional=False, trim="-")
+
+
 def lit(text) -> str:
     """Literal text (a term such as ``d*D``, an id, a path) as typst markup.
 

@@ -12,6 +12,8 @@ import pandas as pd
 
 from hdwf import PARAMETERS
 from hdwf.common.io import read_json
+from hdwf.drive.geometry import E_STEEL, unit_data
+from hdwf.fe.changes import ModelChanges
 from hdwf.fe.cycle import EXIT_ARC_DEG
 from hdwf.fe.hertz import ISO76_BALL_PRESSURE_MPA
 from hdwf.fe.solver import TOL_GAP
@@ -62,17 +64,33 @@ def fe_model_section(doc: Document, assumptions: tuple[dict, ...], pictures: dic
                 else "the full model."))
     if settings.effects:
         doc.text(f"Switched on in the FE studies (`fe.effects`): {effects_text(settings.effects)}"
-                 + (f", the values set on {UNIT_NAMES[settings.calibrated_on]}'s data only; the other drive is a "
+                 + (f", the values set on {UNIT_NAMES[settings.calibrated_on]}’s data only; the other drive is a "
                     "blind prediction with the same values" if settings.calibrated_on else "")
                  + " (`docs/fe-model.md`, \"The studies' model\"). The validation campaigns of Part III start "
-                 "from the bare section instead.")
+                 "from the bare section instead." + _layer_sentence(settings.effects))
     rows = [[lit(a["unit"]), lit(a["name"]), lit(a["value"]), lit(a["source"])] for a in assumptions]
     doc.table(["drive", "quantity", "value", "source or reason"], rows,
-              "Every value the paper does not give, with its source (`hdwf.drive.geometry`).")
+              "The constants of both drives: those the paper gives, with its table, and those it does not, "
+              "with the reason for the value assumed.")
+    gaps = ("the flanks touch (preloaded) and the white gaps are the tip/root clearance" if settings.effects.get("preload")
+            else "the white gaps are the clearance that $r_\"FS\"$ and $r_\"CS\"$ open on the flanks")
     for label, path in pictures.items():
-        doc.figure(path, f"{label}: the FS (left) and CS (right) teeth at the major axis at +4 % $T_N$, true scale; "
-                   "colour: the von Mises stress the test torque adds, where the load goes. The white "
-                   "gaps are the clearance that $r_\"FS\"$ and $r_\"CS\"$ open.", width="75%")
+        doc.figure(path, f"{label}: the teeth at the major axis at +4 % $T_N$, true scale; from the left the "
+                   "bearing's outer ring (grey), the FS wall and its teeth, the CS teeth and rim. Colour: the von "
+                   "Mises stress the test torque adds, where the load goes (the scale ends at the 99th percentile); "
+                   f"{gaps}.", width="75%")
+
+
+def _layer_sentence(effects: dict) -> str:
+    """The flank layer's thickness in modules as the compliance it stands for, on each drive."""
+    if not effects.get("flank_layer"):
+        return ""
+    t = effects["flank_layer"]["thickness_m"]
+    per_drive = ", ".join(f"{fmt(ModelChanges(flank_layer_m=t).layer_um_per_MPa(unit_data(u).module, E_STEEL), 3)} "
+                          f"µm/MPa on {UNIT_NAMES[u]}" for u in ("hd42", "hd120"))
+    return (f" The layer is no physical layer: its {t:g} modules are the compliance per unit flank area of a steel "
+            f"layer that thick, c = t m / E ({per_drive}), the give under each tooth that a plane section lacks "
+            "(cup wall, diaphragm, the face across its width), set so that the level matches the paper's HD 42.")
 
 
 def _convergence_rows(conv: pd.DataFrame, levels: tuple[str, ...]) -> list[list[str]]:
@@ -112,7 +130,7 @@ def convergence_section(doc: Document, study: StudyArtefacts, level: int = 1) ->
     doc.heading("Mesh convergence", level)
     doc.text("The designs of the `fe` study are solved on other meshes too (element density factors below): every "
              "design on the two finest, representative designs also on the third. The grid convergence index "
-             "(Celik et al. 2008) uses the tooth element size as the mesh size; *change* is the relative "
+             "(Celik et al., J. Fluids Eng. 130, 078001, 2008) uses the tooth element size as the mesh size; *change* is the relative "
              "difference of $Phi$ between the two finest meshes, required below 2 %. The change is no error "
              "bound: where the three meshes give no order (marked \\*) they are not yet in the asymptotic range, "
              "and the GCI, not the change, estimates the error; docs/fe-model.md (Mesh convergence) holds the "
@@ -282,6 +300,9 @@ def _indices_rows(pub: pd.DataFrame, unit: str, studies: list[StudyArtefacts]) -
     return rows
 
 
+_BOUNDS_WORDS = {"table3": "the paper's Table 3 bounds", "design_range": "the range its 27 designs span"}
+
+
 def indices_vs_paper_section(doc: Document, units: list[str], data_dir, studies: list[StudyArtefacts],
                              level: int = 1) -> None:
     """Every study's exact Sobol' indices, Spearman ρ and surrogate quality beside the paper's.
@@ -301,6 +322,12 @@ def indices_vs_paper_section(doc: Document, units: list[str], data_dir, studies:
     """
     pub = load_published(data_dir)
     doc.heading("Sensitivity: our FE studies beside the paper", level)
+    doc.text("The indices of a surrogate hold over the bounds it is integrated over, and the studies' differ: "
+             + "; ".join(f"{lit(study.name)} over {_BOUNDS_WORDS.get(b, lit(b))}"
+                         for study in studies for b in {read_json(study.drive(units[0]).surrogate)["bounds_source"]})
+             + ". Part of a difference between columns is the range, not the model: the paper's designs leave part "
+             "of Table 3’s ranges empty (Part I, Designs: the least-covered input), and an input whose range is cut "
+             "weighs less.")
     for u in units:
         heads = ["param.", "published $S_i$", "published $S_(T i)$"]   # the study "paper" is ours on its data
         for study in studies:

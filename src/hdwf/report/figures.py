@@ -12,7 +12,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 from matplotlib.collections import PolyCollection
-from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator, NullFormatter
 from scipy.optimize import isotonic_regression
 
 from hdwf import PARAMETER_COLUMNS, PARAMETER_LABELS, PARAMETERS
@@ -68,7 +68,10 @@ def correlation_figure(designs: pd.DataFrame, corr: pd.DataFrame, title: str, pa
         The figure's title and PNG file.
     """
     y = designs["lost_motion_arcmin"].to_numpy(float)
-    fig, axes = plt.subplots(1, 5, figsize=(15, 3.2), sharey=True, layout="constrained")
+    # two rows of three at page width, so that ticks and legend stay legible; the sixth panel
+    # holds the legend, clear of the data
+    fig, grid = plt.subplots(2, 3, figsize=(10, 6.2), sharey=True, layout="constrained")
+    axes, legend_ax = grid.ravel()[:5], grid.ravel()[5]
     for ax, p, col in zip(axes, PARAMETERS, PARAMETER_COLUMNS):
         x = designs[col].to_numpy(float)
         ok = np.isfinite(y)
@@ -85,9 +88,13 @@ def correlation_figure(designs: pd.DataFrame, corr: pd.DataFrame, title: str, pa
         ax.set_title(f"r = {r:.3f}, ρ = {rho:.3f}", fontsize=9)
         ax.set_xlabel(_label(p))
         ax.ticklabel_format(axis="x", useOffset=False)
-        ax.tick_params(axis="x", labelrotation=30, labelsize=7)
-    axes[0].set_ylabel("lost motion Φ (arcmin)")
-    axes[0].legend(fontsize=7)
+        ax.xaxis.set_major_locator(MaxNLocator(4))
+        ax.tick_params(labelsize=9)
+        ax.grid(alpha=0.3)
+    for ax in grid[:, 0]:
+        ax.set_ylabel("lost motion Φ (arcmin)")
+    legend_ax.axis("off")
+    legend_ax.legend(*axes[0].get_legend_handles_labels(), loc="center", fontsize=10)
     fig.suptitle(title)
     _save(fig, path)
 
@@ -105,16 +112,20 @@ def surrogate_figure(designs: pd.DataFrame, fitted: np.ndarray, title: str, path
         The figure's title and PNG file.
     """
     y = designs["lost_motion_arcmin"].to_numpy(float)
-    fig, axes = plt.subplots(1, 6, figsize=(17, 3.2), layout="constrained")
+    fig, grid = plt.subplots(2, 3, figsize=(10, 6.2), layout="constrained")   # legible at page width
+    axes = grid.ravel()
     for ax, p, col in zip(axes, PARAMETERS, PARAMETER_COLUMNS):
         x = designs[col].to_numpy(float)
         ax.plot(x, y, "o", mfc="none", color="tab:blue", label="data")
         ax.plot(x, fitted, "*", color="tab:red", label="quadratic")
         ax.set_xlabel(_label(p))
         ax.ticklabel_format(axis="x", useOffset=False)
-        ax.tick_params(axis="x", labelrotation=30, labelsize=7)
-    axes[0].set_ylabel("Φ (arcmin)")
-    axes[0].legend(fontsize=7)
+        ax.xaxis.set_major_locator(MaxNLocator(4))
+        ax.tick_params(labelsize=9)
+        ax.grid(alpha=0.3)
+    for ax in grid[:, 0]:
+        ax.set_ylabel("Φ (arcmin)")
+    axes[0].legend(fontsize=9)
     ax = axes[5]
     lim = [min(y.min(), fitted.min()), max(y.max(), fitted.max())]
     ax.plot(lim, lim, "-", color="grey", lw=0.8)

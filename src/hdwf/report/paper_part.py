@@ -121,7 +121,8 @@ def designs_section(doc: Document, study: StudyArtefacts, level: int = 1) -> Non
     doc.table(["design", "centered $L_2$ discrepancy", "maximin distance", "max |r| between inputs",
                "least-covered input"], rows,
               "Space-filling criteria (unit cube of the paper's Table 3 bounds): lower discrepancy and correlation, larger "
-              "distance are better. Least-covered input: the input whose design values span the least of its "
+              "distance are better; they depend only on the design's points in the unit cube, so one seeded "
+              "hypercube scaled to both drives scores the same on each. Least-covered input: the input whose design values span the least of its "
               "bounds, and the span; a design that leaves part of a range empty scores a high discrepancy, and "
               "indices over the full bounds extrapolate its surrogate there.")
 

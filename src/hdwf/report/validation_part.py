@@ -15,7 +15,8 @@ from hdwf.drive.design import MeshSettings
 from hdwf.fe.hertz import ISO76_BALL_PRESSURE_MPA
 from hdwf.fe.relinearise import REDETECTED_LIMIT
 from hdwf.report.artefacts import CampaignArtefacts
-from hdwf.report.document import UNIT_NAMES, Document, fmt, lit
+from hdwf.report.document import UNIT_NAMES, Document, fmt, lit, significant
+from hdwf.report.recovery_part import recovery_section
 from hdwf.validation.effects import get as get_effect
 
 
@@ -31,15 +32,10 @@ def _effect_sentence(r: dict) -> str:
     return f"*{lit(eff.title)}* ({lit(pname)} = {_estimate(val, r.get('param_sd'))} {lit(eff.param(pname).unit)})"
 
 
-def _significant(value: float, digits: int = 4) -> str:
-    """A calibrated value to ``digits`` significant figures, never in exponent notation."""
-    return np.format_float_positional(value, precision=digits, unique=False, fractional=False, trim="-")
-
-
 def _rung_values(effects_json: str) -> str:
     """A ladder rung's effects as solved: each calibrated parameter with its unit."""
     effects = json.loads(effects_json)
-    parts = [f"{lit(p)} = {_significant(v)} {lit(get_effect(e).param(p).unit)}"
+    parts = [f"{lit(p)} = {significant(v)} {lit(get_effect(e).param(p).unit)}"
              for e, params in sorted(effects.items()) for p, v in params.items()]
     return "; ".join(parts) if parts else "–"
 
@@ -67,8 +63,8 @@ def _found_beyond_realistic(diag: dict, det: dict) -> str:
         value = final.get(c["effect"], {}).get(c["param"])
         if c["visible"] or value is None:
             continue
-        parts.append(f"{lit(c['effect'])} at {lit(c['param'])} = {_significant(value)} {lit(c['unit'])} "
-                     f"against a realistic {_significant(c['realistic'])}")
+        parts.append(f"{lit(c['effect'])} at {lit(c['param'])} = {significant(value)} {lit(c['unit'])} "
+                     f"against a realistic {significant(c['realistic'])}")
     if not parts:
         return ""
     return ("Found although this data could not have shown it at a realistic value: " + "; ".join(parts)
@@ -413,6 +409,7 @@ def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2,
         doc.text(bearing)
     doc.figure(campaign.ladder_png, "The error falling rung by rung (each rung adds the effect it names; "
                "a logarithmic axis when the error falls more than tenfold).", width="75%")
+    recovery_section(doc, diag, level + 1)
     for name, note in diag.get("notes", {}).items():
         doc.text(f"Note on {lit(name)}: {lit(note)}.")
 

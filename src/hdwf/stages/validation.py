@@ -10,7 +10,7 @@ from __future__ import annotations
 # The figures (matplotlib) and the diagnosis (statsmodels) are imported by the stages that use
 # them: the Snakefile imports this module to plan the campaigns, and the ladder needs neither.
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -20,6 +20,7 @@ from hdwf.common.io import read_json, write_json, write_parquet
 from hdwf.common.jsonsafe import json_safe
 from hdwf.validation.ladder import ladder_variants, solve_ladder
 from hdwf.validation.measurements import MeasurementError, load_measurements, schedule_problems
+from hdwf.validation.recovery import recovery
 from hdwf.validation.variants import SolveSetup, candidate_names, plan_variants, specimen_solver
 
 if TYPE_CHECKING:
@@ -40,6 +41,7 @@ class CampaignPlan:
     settings: dict         # mesh settings of its solves
     steps_per_ramp: int
     about: str = ""        # what the measurements are, for the report
+    hidden_effects: dict = field(default_factory=dict)   # synthetic data: {effect: {param: value}} made with
 
     def table_variants(self) -> list[dict]:
         """The variants every specimen's table holds (``hdwf.validation.variants.plan_variants``)."""
@@ -102,7 +104,8 @@ def campaign_plan(name: str, camp: dict, fe: dict) -> CampaignPlan:
                 "symmetry": fe.get("symmetry", "full")}
     return CampaignPlan(name, camp["unit"], camp["measurements"], fixed, calib, cands,
                         int(camp.get("rounds", 2)), settings,
-                        int(camp.get("steps_per_ramp", fe["steps_per_ramp"])), camp.get("about", ""))
+                        int(camp.get("steps_per_ramp", fe["steps_per_ramp"])), camp.get("about", ""),
+                        {e: {p: float(v) for p, v in ps.items()} for e, ps in camp.get("hidden_effects", {}).items()})
 
 
 def campaign_specimens(plan: CampaignPlan) -> pd.DataFrame:
@@ -180,9 +183,12 @@ def diagnosis_stage(plan: CampaignPlan, inputs: CampaignInputs, out_json, out_po
     solve = specimen_solver(plan.solve_setup(jobs), meas.specimens)
     from hdwf.validation.diagnosis import diagnose
     diagnosis = diagnose(meas, table, plan.search(), solve=solve)
-    result = json_safe({"campaign": plan.name, "unit": plan.unit, "measurements": str(inputs.measurements),
-                        "about": plan.about,
-                        "mesh": plan.settings, **diagnosis.to_dict(), "provenance": provenance})
+    result = {"campaign": plan.name, "unit": plan.unit, "measurements": str(inputs.measurements),
+              "about": plan.about, "mesh": plan.settings, **diagnosis.to_dict()}
+    if plan.hidden_effects:
+        result["hidden_effects"] = plan.hidden_effects
+        result["recovery"] = recovery(plan.hidden_effects, result["found"]).to_dict()
+    result = json_safe({**result, "provenance": provenance})
     write_parquet(diagnosis.points, out_points, provenance=provenance, meta={"campaign": plan.name, "unit": plan.unit})
     write_json(result, out_json)
     return result
