@@ -65,7 +65,7 @@ def inputs_section(doc: Document, units: list[str], data_dir, level: int = 1) ->
     for u in units:
         b = load_bounds(data_dir, u)
         for limit in ("nominal", "minimal", "maximal"):
-            rows.append([f"{UNIT_NAMES[u]} {limit}"] + [fmt(b.loc[limit, c], 3) for c in PARAMETER_COLUMNS])
+            rows.append([f"{UNIT_NAMES[u]} {limit}"] + [f"{b.loc[limit, c]:.3f}" for c in PARAMETER_COLUMNS])
     doc.table(["", *[f"{math_label(p)} (mm)" for p in PARAMETERS]], rows,
               "Parameter bounds of the study (paper Table 3).")
 
