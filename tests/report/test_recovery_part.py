@@ -25,7 +25,7 @@ FOUND = [{"effect": "thermal", "params": {"delta_T_K": 12.058}, "param_sd": 0.06
 
 def _diag(found):
     return {"unit": "hd42", "noise_arcmin": 0.02, "hidden_effects": HIDDEN,
-            "recovery": recovery(HIDDEN, found).to_dict(),
+            "recovery": recovery(HIDDEN, found, [f["effect"] for f in found]).to_dict(),
             "verdict": {"found_in_order": [f["effect"] for f in found]}}
 
 
@@ -36,8 +36,8 @@ def test_the_chapter_holds_each_found_value_against_the_hidden_one():
     recovery_section(doc, _diag(FOUND), 3)
     table = next(b for b in doc.blocks if b["type"] == "table")
     rows = {r[0]: r[1:] for r in table["rows"]}
-    assert rows["thermal"][1:] == ["12 K", "12.058 K ± 0.068", "0.86", "yes"]
-    assert rows[lit("fs_cup_torsion")][1:] == ["50000 N·m/rad", "48598 N·m/rad ± 1800", "-0.77", "yes"]
+    assert rows["thermal"][1:] == ["12 K", "12.058 ± 0.068 K", "+0.86", "yes"]
+    assert rows[lit("fs_cup_torsion")][1:] == ["50000 N·m/rad", "48598 ± 1800 N·m/rad", "-0.77", "yes"]
     text = next(b["text"] for b in doc.blocks if b["type"] == "text")
     assert text.startswith("The campaign recovered every hidden effect (2 of 2 recovered, each within 0.86 sd)")
 

@@ -28,6 +28,8 @@ def effects_text(effects) -> str:
 #: What "agrees with the paper" means here (issue 15; docs/fe-model.md): level, rank, shape and the
 #: offset slope dΦ/dr_FS, ours over the paper's
 AGREEMENT_TARGETS = {"median_ratio": (0.67, 1.5), "spearman": 0.9, "r2": 0.8, "slope_ratio": (0.5, 2.0)}
+#: a target met in fewer than this share of the mesh-scatter draws is said to be at risk
+AT_RISK_SHARE = 0.95
 #: each target as the closed interval [low, high] its figure must lie in
 TARGET_BOUNDS = {figure: target if isinstance(target, tuple) else (target, np.inf)
                  for figure, target in AGREEMENT_TARGETS.items()}
@@ -47,13 +49,20 @@ def _target_checks(name: str, a: Agreement, slope_ratio: float, band: ScatterBan
     missed, at_risk = [], []
     for figure, label, value, how in checks:
         low, high = TARGET_BOUNDS[figure]
-        share = band.share(figure, low, high) if band is not None and figure in band.samples else None
+        share = _draw_share(figure, band)
         said = "" if share is None else f" (met in {share * 100:.1f} % of the mesh-scatter draws)"
         if not low <= value <= high:
             missed.append(f"{name}: {label} {how}{said}")
-        elif share is not None and share < 0.95:
+        elif share is not None and share < AT_RISK_SHARE:
             at_risk.append(f"{name}: {label}{said}")
     return missed, at_risk
+
+
+def _draw_share(figure: str, band: ScatterBand | None) -> float | None:
+    """The share of the mesh-scatter draws in which ``figure`` meets its target, without a band None."""
+    if band is None or figure not in band.samples:
+        return None
+    return band.share(figure, *TARGET_BOUNDS[figure])
 
 
 def _scatter_table(doc: Document, rows: list[list[str]]) -> None:
@@ -117,12 +126,18 @@ def mesh_scatter(pa: PaperAgreement, convergence) -> tuple[pd.Series, ScatterBan
 
 
 def at_risk_note(figure: str, value: float, band: ScatterBand | None) -> str:
-    """' (met in 60.6 % of the mesh-scatter draws)' for a target met in fewer than 95 % of them, else ''."""
-    if band is None or figure not in band.samples:
-        return ""
+    """' (met in 60.6 % of the mesh-scatter draws)' for a met target that fewer than
+    ``AT_RISK_SHARE`` of the draws meet, else ''."""
     low, high = TARGET_BOUNDS[figure]
-    share = band.share(figure, low, high)
-    return f" (met in {share * 100:.1f} % of the mesh-scatter draws)" if low <= value <= high and share < 0.95 else ""
+    share = _draw_share(figure, band)
+    if share is None or not low <= value <= high or share >= AT_RISK_SHARE:
+        return ""
+    return f" (met in {share * 100:.1f} % of the mesh-scatter draws)"
+
+
+def fe_mesh_changes(fe_studies) -> dict[str, Path]:
+    """Per drive, the ``convergence.parquet`` of the FE study that has one: its measured mesh changes."""
+    return {d.unit: d.convergence for s in fe_studies for d in s.drives if d.convergence}
 
 
 def drive_role(settings: FeSettings | None, unit: str) -> str:

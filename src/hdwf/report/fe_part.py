@@ -17,7 +17,7 @@ from hdwf.fe.changes import ModelChanges
 from hdwf.fe.cycle import EXIT_ARC_DEG
 from hdwf.fe.hertz import ISO76_BALL_PRESSURE_MPA
 from hdwf.fe.solver import TOL_GAP
-from hdwf.report.agreement_part import AGREEMENT_TARGETS, agreement_section, effects_text
+from hdwf.report.agreement_part import AGREEMENT_TARGETS, agreement_section, effects_text, fe_mesh_changes
 from hdwf.report.artefacts import FeSettings, ReportInputs, StudyArtefacts
 from hdwf.report.catalogue_part import catalogue_section
 from hdwf.report.document import UNIT_NAMES, Document, fmt, lit, math_label
@@ -67,12 +67,13 @@ def fe_model_section(doc: Document, assumptions: tuple[dict, ...], pictures: dic
                  + (f", the values set on {UNIT_NAMES[settings.calibrated_on]}’s data only; the other drive is a "
                     "blind prediction with the same values" if settings.calibrated_on else "")
                  + " (`docs/fe-model.md`, \"The studies' model\"). The validation campaigns of Part III start "
-                 "from the bare section instead." + _layer_sentence(settings.effects))
+                 "from the bare section instead." + _layer_sentence(settings))
     rows = [[lit(a["unit"]), lit(a["name"]), lit(a["value"]), lit(a["source"])] for a in assumptions]
     doc.table(["drive", "quantity", "value", "source or reason"], rows,
               "The constants of both drives: those the paper gives, with its table, and those it does not, "
               "with the reason for the value assumed.")
-    gaps = ("the flanks touch (preloaded) and the white gaps are the tip/root clearance" if settings.effects.get("preload")
+    preloaded = (settings.effects.get("preload") or {}).get("interference_m", 0) > 0
+    gaps = ("the flanks touch (preloaded) and the white gaps are the tip/root clearance" if preloaded
             else "the white gaps are the clearance that $r_\"FS\"$ and $r_\"CS\"$ open on the flanks")
     for label, path in pictures.items():
         doc.figure(path, f"{label}: the teeth at the major axis at +4 % $T_N$, true scale; from the left the "
@@ -81,16 +82,18 @@ def fe_model_section(doc: Document, assumptions: tuple[dict, ...], pictures: dic
                    f"{gaps}.", width="75%")
 
 
-def _layer_sentence(effects: dict) -> str:
+def _layer_sentence(settings: FeSettings) -> str:
     """The flank layer's thickness in modules as the compliance it stands for, on each drive."""
-    if not effects.get("flank_layer"):
+    if not settings.effects.get("flank_layer"):
         return ""
-    t = effects["flank_layer"]["thickness_m"]
+    t = settings.effects["flank_layer"]["thickness_m"]
+    calibrated = (f", set so that the level matches the paper's on {UNIT_NAMES[settings.calibrated_on]}"
+                  if settings.calibrated_on else "")
     per_drive = ", ".join(f"{fmt(ModelChanges(flank_layer_m=t).layer_um_per_MPa(unit_data(u).module, E_STEEL), 3)} "
                           f"µm/MPa on {UNIT_NAMES[u]}" for u in ("hd42", "hd120"))
     return (f" The layer is no physical layer: its {t:g} modules are the compliance per unit flank area of a steel "
             f"layer that thick, c = t m / E ({per_drive}), the give under each tooth that a plane section lacks "
-            "(cup wall, diaphragm, the face across its width), set so that the level matches the paper's HD 42.")
+            f"(cup wall, diaphragm, the face across its width){calibrated}.")
 
 
 def _convergence_rows(conv: pd.DataFrame, levels: tuple[str, ...]) -> list[list[str]]:
@@ -300,7 +303,7 @@ def _indices_rows(pub: pd.DataFrame, unit: str, studies: list[StudyArtefacts]) -
     return rows
 
 
-_BOUNDS_WORDS = {"table3": "the paper's Table 3 bounds", "design_range": "the range its 27 designs span"}
+_BOUNDS_WORDS = {"table3": "the paper's Table 3 bounds", "design_range": "the range its designs span"}
 
 
 def indices_vs_paper_section(doc: Document, units: list[str], data_dir, studies: list[StudyArtefacts],
@@ -369,7 +372,7 @@ def fe_part(doc: Document, report: ReportInputs, tmp: Path) -> None:
     at_paper = [s for s in fe_studies if s.designs == "paper"]
     if at_paper and paper_studies:
         units = [u for u in at_paper[0].units if u in paper_studies[0].units]
-        mesh_changes = {d.unit: d.convergence for s in fe_studies for d in s.drives if d.convergence}
+        mesh_changes = fe_mesh_changes(fe_studies)
         agreement_section(doc, units, paper_studies[0], at_paper[0], tmp, report.fe_settings, 2, mesh_changes)
         knee_section(doc, units, report.data_dir, paper_studies[0], at_paper[0], tmp, 2)
         rank_split_section(doc, units, report.data_dir, paper_studies[0], at_paper[0],

@@ -4,12 +4,21 @@ report's summary."""
 
 from __future__ import annotations
 
-from hdwf.report.document import Document, fmt, lit, significant
+from hdwf.report.document import Document, lit, significant
 from hdwf.validation.effects import get as get_effect
 
 
-def _value(effect: str, param: str, value: float) -> str:
-    return f"{value:.6g} {lit(get_effect(effect).param(param).unit)}"
+def _unit(effect: str, param: str) -> str:
+    return lit(get_effect(effect).param(param).unit)
+
+
+def _found(p: dict) -> str:
+    """The found value with its sd and unit ('12.058 ± 0.068 K'), or why there is none."""
+    if p["found"] is None:
+        return "not named"
+    sd = f" ± {significant(p['sd'], 2)}" if p["sd"] is not None else ""
+    told = "" if p["named"] else " (calibrated as told, not named)"
+    return f"{significant(p['found'], 5)}{sd} {_unit(p['effect'], p['param'])}{told}"
 
 
 def recovery_summary(rec: dict) -> str:
@@ -17,14 +26,22 @@ def recovery_summary(rec: dict) -> str:
     params = rec["parameters"]
     n_ok = sum(p["recovered"] for p in params)
     offs = [abs(p["off_by_sd"]) for p in params if p["off_by_sd"] is not None]
-    worst = f", each within {fmt(max(offs), 2)} sd" if offs and n_ok == len(params) else ""
-    extra = f"; also named, not hidden: {lit(', '.join(rec['not_hidden']))}" if rec["not_hidden"] else ""
+    worst = f", each within {max(offs):.2f} sd" if offs and n_ok == len(params) else ""
+    extra = "; also named, not hidden: " + ", ".join(lit(e) for e in rec["not_hidden"]) if rec["not_hidden"] else ""
     return f"{n_ok} of {len(params)} recovered{worst}{extra}"
 
 
 def hidden_text(hidden: dict) -> str:
     """The hidden effects and values, as a cell: ``thermal 12 K, fs_cup_torsion 50000 N·m/rad``."""
-    return ", ".join(f"{lit(e)} {_value(e, p, v)}" for e, ps in hidden.items() for p, v in ps.items())
+    return ", ".join(f"{lit(e)} {significant(v, 5)} {_unit(e, p)}" for e, ps in hidden.items() for p, v in ps.items())
+
+
+def _verdict(rec: dict) -> str:
+    if rec["all_recovered"]:
+        return "The campaign recovered every hidden effect"
+    if rec["every_hidden_recovered"]:
+        return "The campaign recovered every hidden effect, but named more than was hidden"
+    return "The campaign did not recover every hidden effect"
 
 
 def recovery_section(doc: Document, diag: dict, level: int) -> None:
@@ -33,21 +50,14 @@ def recovery_section(doc: Document, diag: dict, level: int) -> None:
     if not rec:
         return
     doc.heading("Against what was hidden", level)
-    rows = []
-    for p in rec["parameters"]:
-        found = "not named" if p["found"] is None else _value(p["effect"], p["param"], p["found"])
-        if p["found"] is not None and p["sd"]:
-            found += f" ± {significant(p['sd'], 2)}"
-        rows.append([lit(p["effect"]), lit(p["param"]), _value(p["effect"], p["param"], p["hidden"]), found,
-                     "–" if p["off_by_sd"] is None else fmt(p["off_by_sd"], 2),
-                     "yes" if p["recovered"] else "*no*"])
-    within = rec["within_sd"]
+    rows = [[lit(p["effect"]), lit(p["param"]), f"{significant(p['hidden'], 5)} {_unit(p['effect'], p['param'])}",
+             _found(p), "–" if p["off_by_sd"] is None else f"{p['off_by_sd']:+.2f}",
+             "yes" if p["recovered"] else "*no*"] for p in rec["parameters"]]
     doc.table(["effect", "parameter", "hidden in the data", "found (final, ± 1 sd)", "found − hidden (sd)",
                "recovered"], rows,
-              f"The data were made with these effects switched on; the campaign was not told them. Recovered: named, "
-              f"and its final calibrated value within {within:g} standard uncertainties of the hidden one.")
+              f"The data were made with these effects switched on; the campaign was not told them. Recovered: named "
+              f"by the search, and its final calibrated value within {rec['within_sd']:g} standard uncertainties of "
+              "the hidden one (a value without a finite uncertainty is not counted).")
     order = diag.get("verdict", {}).get("found_in_order") or []
-    verdict = ("The campaign recovered every hidden effect" if rec["all_recovered"] else
-               "The campaign did not recover every hidden effect")
-    doc.text(f"{verdict} ({recovery_summary(rec)}); it named "
-             + (lit(", then ".join(order)) if order else "nothing") + ".")
+    doc.text(f"{_verdict(rec)} ({recovery_summary(rec)}); it named "
+             + (", then ".join(lit(o) for o in order) if order else "nothing") + ".")

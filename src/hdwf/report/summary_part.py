@@ -11,8 +11,8 @@ import pandas as pd
 
 from hdwf.common.io import read_json
 from hdwf.fe.hertz import ISO76_BALL_PRESSURE_MPA
-from hdwf.report.agreement_part import (AGREEMENT_TARGETS, TARGET_BOUNDS, at_risk_note, drive_role, mesh_scatter,
-                                        paper_agreement)
+from hdwf.report.agreement_part import (AGREEMENT_TARGETS, TARGET_BOUNDS, at_risk_note, drive_role,
+                                        fe_mesh_changes, mesh_scatter, paper_agreement)
 from hdwf.report.artefacts import ReportInputs
 from hdwf.report.catalogue_part import catalogue_checks, catalogue_phi_text, span_text
 from hdwf.report.document import UNIT_NAMES, Document, fmt, lit
@@ -64,7 +64,7 @@ def _fe_model(report: ReportInputs) -> list[Finding]:
     s_lo, s_hi = AGREEMENT_TARGETS["slope_ratio"]
     rho, r2 = AGREEMENT_TARGETS["spearman"], AGREEMENT_TARGETS["r2"]
     paper, ours = report.paper_studies[0], at_paper[0]
-    mesh_changes = {d.unit: d.convergence for s in report.fe_studies for d in s.drives if d.convergence}
+    mesh_changes = fe_mesh_changes(report.fe_studies)
     for unit in (u for u in ours.units if u in paper.units):
         pa = paper_agreement(paper, ours, unit)
         band = mesh_scatter(pa, mesh_changes[unit])[1] if mesh_changes.get(unit) else None

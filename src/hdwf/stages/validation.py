@@ -187,7 +187,8 @@ def diagnosis_stage(plan: CampaignPlan, inputs: CampaignInputs, out_json, out_po
               "about": plan.about, "mesh": plan.settings, **diagnosis.to_dict()}
     if plan.hidden_effects:
         result["hidden_effects"] = plan.hidden_effects
-        result["recovery"] = recovery(plan.hidden_effects, result["found"]).to_dict()
+        result["recovery"] = recovery(plan.hidden_effects, result["found"],
+                                      result["verdict"].get("found_in_order") or []).to_dict()
     result = json_safe({**result, "provenance": provenance})
     write_parquet(diagnosis.points, out_points, provenance=provenance, meta={"campaign": plan.name, "unit": plan.unit})
     write_json(result, out_json)

@@ -5,6 +5,7 @@ is known (``hdwf synth``; a campaign's ``hidden_effects`` in ``config.yaml``).""
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass
 
 # A found value counts as recovered within this many of its standard uncertainties of the hidden
@@ -14,29 +15,28 @@ RECOVERED_WITHIN_SD = 3.0
 
 @dataclass(frozen=True)
 class HiddenParameter:
-    """One hidden parameter against the campaign's finding (``found`` None: effect not named)."""
+    """One hidden parameter against the campaign's finding."""
 
     effect: str
     param: str
     hidden: float
-    found: float | None
-    sd: float | None           # the found value's standard uncertainty, where the diagnosis gives one
+    found: float | None        # its final calibrated value; None: the effect was never calibrated
+    sd: float | None           # that value's standard uncertainty, where the diagnosis gives one
+    named: bool                # the search named the effect (not one the campaign was told to calibrate)
 
     @property
     def off_by_sd(self) -> float | None:
-        """(found − hidden) in standard uncertainties, or None without a finding or an uncertainty."""
-        if self.found is None or not self.sd:
+        """(found − hidden) in standard uncertainties; None without a value or a finite, positive sd
+        (a singular fit's is infinite: it says nothing about where the value lies)."""
+        if self.found is None or self.sd is None or not (math.isfinite(self.sd) and self.sd > 0):
             return None
         return (self.found - self.hidden) / self.sd
 
     @property
     def recovered(self) -> bool:
-        """Named, and within ``RECOVERED_WITHIN_SD`` of the hidden value (exactly equal without an sd)."""
-        if self.found is None:
-            return False
-        if not self.sd:
-            return self.found == self.hidden
-        return abs(self.off_by_sd) <= RECOVERED_WITHIN_SD
+        """Named by the search, and within ``RECOVERED_WITHIN_SD`` of the hidden value."""
+        off = self.off_by_sd
+        return self.named and off is not None and abs(off) <= RECOVERED_WITHIN_SD
 
     def to_dict(self) -> dict:
         return {**asdict(self), "off_by_sd": self.off_by_sd, "recovered": self.recovered}
@@ -47,18 +47,24 @@ class Recovery:
     """Every hidden parameter against the finding, and the effects named that were not hidden."""
 
     parameters: tuple[HiddenParameter, ...]
-    not_hidden: tuple[str, ...]        # named by the campaign, not in the data
+    not_hidden: tuple[str, ...]        # named by the search, not in the data
+
+    @property
+    def every_hidden_recovered(self) -> bool:
+        return all(p.recovered for p in self.parameters)
 
     @property
     def all_recovered(self) -> bool:
-        return all(p.recovered for p in self.parameters) and not self.not_hidden
+        """Every hidden parameter recovered and nothing named that was not hidden."""
+        return self.every_hidden_recovered and not self.not_hidden
 
     def to_dict(self) -> dict:
         return {"within_sd": RECOVERED_WITHIN_SD, "parameters": [p.to_dict() for p in self.parameters],
-                "not_hidden": list(self.not_hidden), "all_recovered": self.all_recovered}
+                "not_hidden": list(self.not_hidden), "every_hidden_recovered": self.every_hidden_recovered,
+                "all_recovered": self.all_recovered}
 
 
-def recovery(hidden: dict[str, dict[str, float]], found: list[dict]) -> Recovery:
+def recovery(hidden: dict[str, dict[str, float]], found: list[dict], named: list[str]) -> Recovery:
     """Hold a campaign's found effects against the hidden ones.
 
     Parameters
@@ -67,12 +73,14 @@ def recovery(hidden: dict[str, dict[str, float]], found: list[dict]) -> Recovery
         ``{effect: {parameter: value}}`` the data were made with.
     found : list of dict
         ``diagnosis.json``'s ``found``: per effect ``effect``, ``params`` and ``param_sd`` (the
-        final, recalibrated values).
+        final, recalibrated values), the effects the campaign was told to calibrate among them.
+    named : list of str
+        The effects the search named (``verdict.found_in_order``).
 
     Returns
     -------
     Recovery
-        One ``HiddenParameter`` per hidden parameter, in the order given, and the effects found
+        One ``HiddenParameter`` per hidden parameter, in the order given, and the effects named
         that were not hidden.
     """
     by_effect = {f["effect"]: f for f in found}
@@ -83,5 +91,5 @@ def recovery(hidden: dict[str, dict[str, float]], found: list[dict]) -> Recovery
             got = None if f is None else f["params"].get(param)
             sd = None if f is None or len(f["params"]) != 1 else f.get("param_sd")
             params.append(HiddenParameter(effect, param, float(value), None if got is None else float(got),
-                                          None if sd is None else float(sd)))
-    return Recovery(tuple(params), tuple(e for e in by_effect if e not in hidden))
+                                          None if sd is None else float(sd), effect in named))
+    return Recovery(tuple(params), tuple(e for e in named if e not in hidden))
