@@ -336,6 +336,13 @@ def test_ladder_is_held_against_the_bearing_rating():
     assert "from rung 1 on" in said and "dent" in said
     assert "Every rung stays within it" in _bearing_sentence(lad.iloc[:1])
     assert _bearing_sentence(lad.drop(columns=["specimens_checked"])) == ""
+    # a preload over the rating without the layer, beside the studies' larger one on their layer
+    studies = {"preload": {"interference_m": 0.3}, "flank_layer": {"thickness_m": 3900.0}}
+    lad["effects"] = ["{}", '{"preload": {"interference_m": 0.186}}']
+    assert _bearing_sentence(lad, studies).endswith(
+        "The FE studies of Part II carry a larger allowance (0.3 m) within the rating because their flank layer "
+        "takes up the overlap; this campaign's section has no layer, so its bearing holds the overlap.")
+    assert "flank layer" not in _bearing_sentence(lad, {"preload": {"interference_m": 0.3}})
 
 
 def test_ladder_gives_the_solvers_own_contact_check():

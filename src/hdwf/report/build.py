@@ -95,5 +95,5 @@ def full_report(report: ReportInputs, out) -> Path:
         if report.fe_studies:
             fe_part(doc, report, Path(tmp))
         if report.campaigns:
-            validation_part(doc, report.campaigns, report.fe_settings.mesh)
+            validation_part(doc, report.campaigns, report.fe_settings.mesh, report.fe_settings.effects)
         return doc.compile(out)

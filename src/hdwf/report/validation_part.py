@@ -343,7 +343,22 @@ def _contact_check_sentence(ladder: pd.DataFrame) -> str:
             + (f" *Not made* for {missing} ({why})." if missing else ""))
 
 
-def _bearing_sentence(ladder: pd.DataFrame) -> str:
+def _layer_note(over: pd.DataFrame, studies_effects: dict | None) -> str:
+    """Why the FE studies' larger preload stays within the rating where this campaign's does not."""
+    effects = studies_effects or {}
+    if "effects" not in over or "flank_layer" not in effects or "preload" not in effects:
+        return ""
+    first = json.loads(over["effects"].iloc[0])
+    if "preload" not in first or "flank_layer" in first:
+        return ""
+    theirs = effects["preload"]["interference_m"]
+    size = "a larger allowance" if theirs > first["preload"]["interference_m"] else "an allowance"
+    return (f" The FE studies of Part II carry {size} ({theirs:g} m) "
+            "within the rating because their flank layer takes up the overlap; this campaign's section has no "
+            "layer, so its bearing holds the overlap.")
+
+
+def _bearing_sentence(ladder: pd.DataFrame, studies_effects: dict | None = None) -> str:
     """The rungs held against the wave-generator bearing's static rating (ISO 76, 4200 MPa)."""
     if "specimens_checked" not in ladder or not ladder["specimens_checked"].gt(0).any():
         return ""
@@ -354,14 +369,14 @@ def _bearing_sentence(ladder: pd.DataFrame) -> str:
     over = ladder[ladder["specimens_above_iso76"] > 0]
     verdict = (f" A model whose balls exceed the rating is not one a real drive of these dimensions could be "
                f"assembled to (its raceways would dent): from rung {int(over['rung'].iloc[0])} on, the found "
-               "effect stands in for something the model lacks rather than being it."
+               "effect stands in for something the model lacks rather than being it." + _layer_note(over, studies_effects)
                if len(over) else " Every rung stays within it.")
     return ("Is the model physically admissible? The most loaded wave-generator ball at the mount, against the "
             f"{ISO76_BALL_PRESSURE_MPA:g} MPa static rating of ISO 76, rung by rung: " + "; ".join(parts) + "." + verdict)
 
 
 def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2,
-                     study_mesh: MeshSettings | None = None) -> None:
+                     study_mesh: MeshSettings | None = None, studies_effects: dict | None = None) -> None:
     """One campaign: where the model fails, which effect is missing, what the data could show, the ladder.
 
     Parameters
@@ -374,6 +389,8 @@ def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2,
         Heading level of the chapter; its sections are one level below.
     study_mesh
         The FE studies' mesh: a coarser campaign mesh is said to be so, with what that costs.
+    studies_effects
+        The FE studies' ``fe.effects``: a preload over the bearing's rating is set beside theirs.
     """
     diag = read_json(campaign.diagnosis)
     ladder = pd.read_parquet(campaign.ladder)
@@ -403,7 +420,7 @@ def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2,
     contact = _contact_check_sentence(ladder)
     if contact:
         doc.text(contact)
-    bearing = _bearing_sentence(ladder)
+    bearing = _bearing_sentence(ladder, studies_effects)
     if bearing:
         doc.text(bearing)
     doc.figure(campaign.ladder_png, "The error falling rung by rung (each rung adds the effect it names; "
@@ -414,7 +431,7 @@ def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2,
 
 
 def validation_part(doc: Document, campaigns: tuple[CampaignArtefacts, ...],
-                    study_mesh: MeshSettings | None = None) -> None:
+                    study_mesh: MeshSettings | None = None, studies_effects: dict | None = None) -> None:
     """Part III: a chapter per campaign, in config order.
 
     Parameters
@@ -433,4 +450,4 @@ def validation_part(doc: Document, campaigns: tuple[CampaignArtefacts, ...],
              "when it pays beyond the noise, and re-solves the model with it switched on "
              "(docs/validation.md).")
     for c in campaigns:
-        campaign_chapter(doc, c, 2, study_mesh)
+        campaign_chapter(doc, c, 2, study_mesh, studies_effects)
