@@ -50,12 +50,16 @@ def _target_checks(name: str, a: Agreement, slope_ratio: float, band: ScatterBan
     for figure, label, value, how in checks:
         low, high = TARGET_BOUNDS[figure]
         share = _draw_share(figure, band)
-        said = "" if share is None else f" (met in {share * 100:.1f} % of the mesh-scatter draws)"
+        said = "" if share is None else _share_said(share)
         if not low <= value <= high:
             missed.append(f"{name}: {label} {how}{said}")
         elif share is not None and share < AT_RISK_SHARE:
             at_risk.append(f"{name}: {label}{said}")
     return missed, at_risk
+
+
+def _share_said(share: float) -> str:
+    return f" (met in {share * 100:.1f} % of the mesh-scatter draws)"
 
 
 def _draw_share(figure: str, band: ScatterBand | None) -> float | None:
@@ -132,7 +136,7 @@ def at_risk_note(figure: str, value: float, band: ScatterBand | None) -> str:
     share = _draw_share(figure, band)
     if share is None or not low <= value <= high or share >= AT_RISK_SHARE:
         return ""
-    return f" (met in {share * 100:.1f} % of the mesh-scatter draws)"
+    return _share_said(share)
 
 
 def fe_mesh_changes(fe_studies) -> dict[str, Path]:
