@@ -128,6 +128,9 @@ def test_study_report_stage_writes_the_pdf(named_inputs, tmp_path):
     # 0.6758) and our quadratic surrogate's R² (0.9892, docs/results.md)
     # (the paper's published 0.6758 is printed beside ours, so ours makes it appear twice)
     assert text.count("0.6758") >= 2 and "0.9892" in text
+    # the paper is cited by its authors and listed, with its DOI, among the references at the end
+    assert "Hrcek et al." in text and "[1]" in text
+    assert text.rindex("References") > text.rindex("0.9892") and "doi:10.3390/ma14175057" in text
 
 
 def test_full_report_stage_with_a_paper_study_only(named_inputs, tmp_path):
@@ -488,7 +491,7 @@ def test_a_round_verdict_names_a_paying_runner_up_and_the_evidence_between_them(
            "verdict": {"missing_effect": "fs_cup_torsion", "indistinguishable_from": []},
            "ranking": [cand("fs_cup_torsion", -22.2), cand("cs_housing", -14.1), cand("thermal", -3.0, False)]}
     said = _round_verdict(rnd)
-    assert "The runner-up, cs" in said and "(ΔBIC -14.1)" in said and "is 8.1 lower, strong evidence" in said
+    assert "The runner-up, Circular spline and housing compliance," in said and "(ΔBIC -14.1)" in said and "is 8.1 lower, strong evidence" in said
     rnd["ranking"][1]["delta_bic"] = -10.2
     assert "is 12.0 lower, very strong evidence" in _round_verdict(rnd)
     rnd["ranking"][1]["pays"] = False
@@ -689,7 +692,8 @@ def test_the_deformed_picture_colours_the_stress_the_torque_adds(monkeypatch):
 def test_the_residual_panels_stay_legible_at_page_width(monkeypatch):
     """Six panels in one row of an 18-inch figure printed at page width left 4-pt tick labels; three a
     row keep every panel about 3 inches wide. A curve campaign (five inputs and the curve) fills two
-    rows; a Φ campaign's five inputs leave the sixth cell hidden."""
+    rows; a Φ campaign's five inputs leave the sixth cell to the legend, clear of the data, and a
+    curve campaign's legend goes in one row under the panels."""
     import numpy as np
     import pandas as pd
 
@@ -705,10 +709,45 @@ def test_the_residual_panels_stay_legible_at_page_width(monkeypatch):
                         "torque_Nm": np.tile([0.0, 0.96, 0.0, -0.96], 3), "branch": np.tile(["load+"] * 2 + ["load-"] * 2, 3)})
     figures.residual_figure(pts, "t", "a.png")
     figures.residual_figure(pts.drop(columns=["torque_Nm", "branch"]), "t", "b.png")
-    for fig, shown in zip(drawn, (6, 5)):
-        visible = [ax for ax in fig.axes if ax.get_visible()]
-        assert len(visible) == shown and len(fig.axes) == 6
+    for fig, with_data in zip(drawn, (6, 5)):
+        assert len([ax for ax in fig.axes if ax.lines]) == with_data and len(fig.axes) == 6
         assert fig.get_figwidth() == 9 and len({ax.get_position().x0 for ax in fig.axes}) == 3   # 3 a row, page-wide
+        # no legend drawn over a panel with data
+        assert not [ax for ax in fig.axes if ax.lines and ax.get_legend() is not None]
+    curve_fig, phi_fig = drawn
+    # the curve campaign's legend names both models and the branches, under the panels
+    assert [t.get_text() for t in curve_fig.legends[0].get_texts()] == ["campaign model", "with found effects",
+                                                                         "load+", "load-"]
+    spare = phi_fig.axes[5]
+    assert not spare.axison and [t.get_text() for t in spare.get_legend().get_texts()] == [
+        "campaign model", "with found effects"]
+
+
+def test_the_sobol_convergence_figure_gives_each_input_its_own_panel(monkeypatch):
+    """Two panels of 30 lines could not be told apart: one panel per input, each with both indices
+    for every sampler and the exact values, the sixth cell the legend."""
+    import pandas as pd
+
+    from hdwf import PARAMETERS
+    from hdwf.report import figures
+
+    drawn = []
+    monkeypatch.setattr(figures, "_save", lambda fig, path: drawn.append(fig))
+    rows = [{"sampler": "exact", "parameter": p, "n": 0, "S1": 0.1 * i, "ST": 0.1 * i + 0.05}
+            for i, p in enumerate(PARAMETERS)]
+    rows += [{"sampler": s, "parameter": p, "n": n, "S1": 0.1 * i + 1 / n, "ST": 0.1 * i + 0.05 + 1 / n}
+             for s in ("lhs", "halton", "sobol") for i, p in enumerate(PARAMETERS) for n in (64, 128, 256)]
+    figures.sobol_convergence_figure(pd.DataFrame(rows), "t", "s.png")
+    (fig,) = drawn
+    panels = [ax for ax in fig.axes if ax.lines]
+    assert len(panels) == 5 and len(fig.axes) == 6
+    for ax, p in zip(panels, PARAMETERS):
+        # 3 samplers × 2 indices, and the two exact lines
+        assert len(ax.lines) == 8
+        estimates = [ln for ln in ax.lines if len(ln.get_xdata()) == 3]
+        assert sorted(float(ln.get_ydata()[-1]) for ln in estimates) == pytest.approx(
+            sorted([0.1 * PARAMETERS.index(p) + 1 / 256] * 3 + [0.1 * PARAMETERS.index(p) + 0.05 + 1 / 256] * 3))
+    assert len(fig.axes[5].get_legend().get_texts()) == 8
 
 
 def test_catalogue_section_holds_each_level_against_two_t_over_k1(named_inputs, tmp_path):

@@ -12,6 +12,7 @@ from hdwf.report.document import UNIT_NAMES, Document
 from hdwf.report.fe_part import fe_part
 from hdwf.report.paper_part import (comparison_section, correlation_section, designs_section, inputs_section,
                                     paper_part, sobol_section, surrogate_section)
+from hdwf.report.references import cite, references_section
 from hdwf.report.summary_part import summary_section
 from hdwf.report.validation_part import validation_part
 
@@ -39,10 +40,10 @@ def study_report(study: StudyArtefacts, data_dir, provenance: dict, out) -> Path
     """
     doc = Document(f"hdwf study '{study.name}': lost motion of harmonic drives",
                    _SUBTITLES.get(study.source, study.source), provenance)
-    doc.text("This report reproduces the correlation, surrogate and global-sensitivity analysis of Majchrák et al., "
-             "*Global Sensitivity Analysis of Chosen Harmonic Drive Parameters Affecting Its Lost Motion*, for the "
+    doc.text("This report reproduces the correlation, surrogate and global-sensitivity analysis of Hrcek et al., "
+             f"*Global Sensitivity Analysis of Chosen Harmonic Drive Parameters Affecting Its Lost Motion* {cite('paper')}, for the "
              f"drives {', '.join(UNIT_NAMES[u] for u in study.units)}. Every number and figure below was computed "
-             "by the workflow from the artefacts under `results/`; the provenance above identifies the "
+             f"by the Snakemake workflow {cite('snakemake')} from the artefacts under `results/`; the provenance above identifies the "
              "configuration, code and packages.")
     inputs_section(doc, study.units, data_dir)
     designs_section(doc, study)
@@ -54,6 +55,7 @@ def study_report(study: StudyArtefacts, data_dir, provenance: dict, out) -> Path
     sobol_section(doc, study)
     doc.pagebreak()
     comparison_section(doc, study, data_dir)
+    references_section(doc)
     return doc.compile(out)
 
 
@@ -75,12 +77,12 @@ def full_report(report: ReportInputs, out) -> Path:
     """
     doc = Document("hdwf: lost motion of harmonic drives", "Paper replication, our FE model and its studies",
                    report.provenance)
-    doc.text("Part I reproduces the statistics of Majchrák et al., _Global Sensitivity Analysis of Chosen "
-             "Harmonic Drive Parameters Affecting Its Lost Motion_, from their own FEA tables; Part II solves the same "
+    doc.text("Part I reproduces the statistics of Hrcek et al., _Global Sensitivity Analysis of Chosen "
+             f"Harmonic Drive Parameters Affecting Its Lost Motion_ {cite('paper')}, from their own FEA tables; Part II solves the same "
              "lost-motion test with our FE model, at our own optimal Latin hypercube (`fe`) and at the paper's design "
              "points (`fe_at_paper`), and runs the same chain on it; Part III holds the model against measurement "
              "files, finds which physical effect it misses and re-solves it with that effect. Every number below "
-             "was computed by the workflow from the artefacts under `results/`.")
+             f"was computed by the Snakemake workflow {cite('snakemake')} from the artefacts under `results/`.")
     doc.text("Symbols: the flexspline (FS) is twisted against the held circular spline (CS) to ±T, 4 % of the "
              "rated torque $T_N$ (the paper's Table 1); $phi$ and $phi'$ are the twist magnitudes at +T and −T "
              "and the lost motion is $Phi = phi + phi'$. The five inputs: $d$ and $D$, the bore and outside "
@@ -96,4 +98,5 @@ def full_report(report: ReportInputs, out) -> Path:
             fe_part(doc, report, Path(tmp))
         if report.campaigns:
             validation_part(doc, report.campaigns, report.fe_settings.mesh, report.fe_settings.effects)
+        references_section(doc)
         return doc.compile(out)

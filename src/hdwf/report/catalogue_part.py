@@ -9,6 +9,7 @@ from hdwf.drive.geometry import unit_data
 from hdwf.report.agreement_part import drive_role
 from hdwf.report.artefacts import FeSettings, StudyArtefacts
 from hdwf.report.document import UNIT_NAMES, Document, fmt
+from hdwf.report.references import cite
 from hdwf.study.catalogue import LIMITS, CatalogueCheck, catalogue_check, catalogue_units, size_ratio
 
 
@@ -58,7 +59,7 @@ def catalogue_section(doc: Document, units: list[str], paper: StudyArtefacts, fe
     doc.table(["drive", "catalogue $K_1$ ($10^4$ N·m/rad)", "catalogue $2T slash K_1$",
                *(f"median $Phi$, {label} (over the catalogue's)" for label in levels.values())], rows,
               "Elastic lost motion at ±T of a real unit of the same size, $2T slash K_1$ (arcmin; Harmonic Drive "
-              "CSF, ratio 50; ±T lies below $T_1$), against the median $Phi$ of each set of designs.")
+              f"CSF {cite('catalogue')}, ratio 50; ±T lies below $T_1$), against the median $Phi$ of each set of designs.")
     text = ("A catalogue unit is measured whole, cup, diaphragm, bearing and teeth, by its maker: no model of ours "
             "or the paper's made these numbers. Its backlash and hysteresis (of the order of an arcminute at $T_N$) "
             "are left out here, so $2T slash K_1$ is the part a frictionless model should give. It is held fixed "

@@ -24,6 +24,7 @@ from hdwf.report.document import UNIT_NAMES, Document, fmt, lit, math_label
 from hdwf.report.figures import curves_figure
 from hdwf.report.knee_part import knee_section, rank_split_section
 from hdwf.report.paper_part import correlation_section, exact_sobol, sobol_section, surrogate_section
+from hdwf.report.references import cite
 from hdwf.study.paper import load_published
 
 
@@ -45,7 +46,7 @@ def fe_model_section(doc: Document, assumptions: tuple[dict, ...], pictures: dic
         Heading level of the section.
     """
     doc.heading("The FE model", level)
-    doc.text("A 2D plane-stress section of each drive (gmsh mesh, scikit-fem assembly, linear-elastic steel, "
+    doc.text(f"A 2D plane-stress section of each drive (gmsh mesh {cite('gmsh')}, scikit-fem assembly {cite('skfem')}, linear-elastic steel, "
              "$E = 210$ GPa, $nu = 0.3$, thickness = face width) with unilateral frictionless contact between the "
              "locked wave-generator cam and the bearing inner ring, the balls and both raceways (radial clearance "
              "$G_r$), the outer ring and the flexspline bore (fit from $D$) and the flexspline and circular-spline "
@@ -133,7 +134,7 @@ def convergence_section(doc: Document, study: StudyArtefacts, level: int = 1) ->
     doc.heading("Mesh convergence", level)
     doc.text("The designs of the `fe` study are solved on other meshes too (element density factors below): every "
              "design on the two finest, representative designs also on the third. The grid convergence index "
-             "(Celik et al., J. Fluids Eng. 130, 078001, 2008) uses the tooth element size as the mesh size; *change* is the relative "
+             f"(Celik et al. {cite('celik')}) uses the tooth element size as the mesh size; *change* is the relative "
              "difference of $Phi$ between the two finest meshes, required below 2 %. The change is no error "
              "bound: where the three meshes give no order (marked \\*) they are not yet in the asymptotic range, "
              "and the GCI, not the change, estimates the error; docs/fe-model.md (Mesh convergence) holds the "
@@ -225,9 +226,9 @@ def _ball_load(lm: pd.DataFrame) -> str:
             f"(median {fmt(load.median(), 0)} N), a raceway pressure of {fmt(pressure.min(), 0)}–"
             f"{fmt(pressure.max(), 0)} MPa")
     if not over.any():
-        return text + f", within the {ISO76_BALL_PRESSURE_MPA:g} MPa of the static rating of ISO 76. "
+        return text + f", within the {ISO76_BALL_PRESSURE_MPA:g} MPa of the static rating of ISO 76 {cite('iso76')}. "
     return (text + f"; in {int(over.sum())} of {len(lm)} designs above the {ISO76_BALL_PRESSURE_MPA:g} MPa of "
-            "the static rating of ISO 76, where the raceways dent: a drive preloaded that hard would be damaged at "
+            f"the static rating of ISO 76 {cite('iso76')}, where the raceways dent: a drive preloaded that hard would be damaged at "
             "assembly, so the allowance cannot be read as a real interference of the drive "
             "(docs/fe-model.md, \"Preloaded engagement\"). ")
 

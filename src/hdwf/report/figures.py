@@ -51,8 +51,13 @@ def _save(fig, path):
     plt.close(fig)
 
 
+def _symbol(p):
+    """An input's symbol in matplotlib math, e.g. ``$r_{FS}$``."""
+    return f"${PARAMETER_LABELS[p].replace('_', '_{') + ('}' if '_' in PARAMETER_LABELS[p] else '')}$"
+
+
 def _label(p):
-    return f"${PARAMETER_LABELS[p].replace('_', '_{') + ('}' if '_' in PARAMETER_LABELS[p] else '')}$ (mm)"
+    return f"{_symbol(p)} (mm)"
 
 
 def correlation_figure(designs: pd.DataFrame, corr: pd.DataFrame, title: str, path) -> None:
@@ -138,7 +143,8 @@ def surrogate_figure(designs: pd.DataFrame, fitted: np.ndarray, title: str, path
 
 
 def sobol_convergence_figure(sobol: pd.DataFrame, title: str, path) -> None:
-    """S1 (left) and ST (right) against N for each sampler, exact values as thick lines, as Figs. 13/14.
+    """S1 and ST against N for each sampler, one panel per input, exact values as thick lines
+    (the paper's Figs. 13/14 with the inputs apart: 30 lines in two panels could not be told apart).
 
     Parameters
     ----------
@@ -150,21 +156,27 @@ def sobol_convergence_figure(sobol: pd.DataFrame, title: str, path) -> None:
     exact = sobol[sobol["sampler"] == "exact"].set_index("parameter")
     est = sobol[sobol["sampler"] != "exact"]
     styles = {"lhs": ":", "halton": "--", "sobol": "-"}
-    colors = dict(zip(PARAMETERS, ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple"]))
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4), sharey=True, layout="constrained")
-    for ax, idx in zip(axes, ["S1", "ST"]):
-        for p in PARAMETERS:
+    colors = {"S1": "tab:blue", "ST": "tab:red"}
+    names = {"S1": "first order $S_i$", "ST": "total effect $S_{Ti}$"}
+    fig, grid = plt.subplots(2, 3, figsize=(10, 6.2), layout="constrained")
+    axes, legend_ax = grid.ravel()[:5], grid.ravel()[5]
+    for ax, p in zip(axes, PARAMETERS):
+        for idx in ("S1", "ST"):
             for sampler, sub in est[est["parameter"] == p].groupby("sampler"):
-                ax.plot(sub["n"], sub[idx], styles.get(sampler, "-"), color=colors[p], lw=1,
-                        marker="o" if sampler == "sobol" else None, ms=2.5,
-                        label=f"{PARAMETER_LABELS[p]} ({sampler})" if idx == "S1" else None)
-            ax.axhline(exact.loc[p, idx], color=colors[p], lw=2.0, alpha=0.35)
+                ax.plot(sub["n"], sub[idx], styles.get(sampler, "-"), color=colors[idx], lw=1,
+                        marker="o" if sampler == "sobol" else None, ms=2.5, label=f"{names[idx]}, {sampler}")
+            ax.axhline(exact.loc[p, idx], color=colors[idx], lw=3.0, alpha=0.3, label=f"{names[idx]}, exact")
         ax.set_xscale("log", base=2)
-        ax.set_xlabel("base sample size N")
-        ax.set_title({"S1": "first order $S_i$", "ST": "total effect $S_{Ti}$"}[idx] + " (thick: exact)")
+        ax.set_title(_symbol(p), fontsize=10)
+        ax.tick_params(labelsize=8)
         ax.grid(alpha=0.3)
-    axes[0].set_ylabel("index")
-    axes[0].legend(fontsize=6, ncol=3)
+    for ax in grid[1, :2]:
+        ax.set_xlabel("base sample size N")
+    grid[0, 2].set_xlabel("base sample size N")
+    for ax in grid[:, 0]:
+        ax.set_ylabel("index")
+    legend_ax.axis("off")
+    legend_ax.legend(*axes[0].get_legend_handles_labels(), loc="center", fontsize=8)
     fig.suptitle(title)
     _save(fig, path)
 
@@ -367,7 +379,8 @@ def residual_figure(points: pd.DataFrame, title: str, path) -> None:
     nrows = -(-panels // 3)
     fig, grid = plt.subplots(nrows, 3, figsize=(9, 3.2 * nrows), sharey=True, layout="constrained", squeeze=False)
     axes = list(grid.ravel()[:panels])
-    for spare in grid.ravel()[panels:]:
+    spares = list(grid.ravel()[panels:])
+    for spare in spares:
         spare.set_visible(False)
     r0 = points["D"] - points["S_model"]
     r1 = points["D"] - points["S_final"]
@@ -390,8 +403,17 @@ def residual_figure(points: pd.DataFrame, title: str, path) -> None:
         ax.axhline(0, color="k", lw=0.6)
         ax.set_xlabel("torque (N m)")
         ax.set_title("along the curve (campaign model)", fontsize=9)
-        ax.legend(fontsize=7)
-    axes[0].legend(fontsize=7)
+    # the legend clear of the data: in a spare cell, else one row under the panels
+    handles, labels = [], []
+    for ax in (axes[0], axes[-1]) if curve else (axes[0],):
+        h, lab = ax.get_legend_handles_labels()
+        handles, labels = handles + h, labels + lab
+    if spares:
+        spares[0].set_visible(True)
+        spares[0].axis("off")
+        spares[0].legend(handles, labels, loc="center", fontsize=9)
+    else:
+        fig.legend(handles, labels, loc="outside lower center", ncol=len(labels), fontsize=8)
     fig.suptitle(title)
     _save(fig, path)
 

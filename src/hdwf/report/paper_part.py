@@ -11,6 +11,7 @@ from hdwf import PARAMETER_COLUMNS, PARAMETERS
 from hdwf.common.io import read_json, read_parquet_meta
 from hdwf.report.artefacts import DriveArtefacts, StudyArtefacts
 from hdwf.report.document import UNIT_NAMES, Document, fmt, lit, math_label
+from hdwf.report.references import cite
 from hdwf.study.doe import space_filling, to_unit
 from hdwf.study.paper import load_bearings, load_bounds, load_drives, load_published
 
@@ -140,7 +141,7 @@ def correlation_section(doc: Document, study: StudyArtefacts, level: int = 1) ->
         Heading level of the section.
     """
     doc.heading("Correlation", level)
-    doc.text("Multiple linear regression of $Phi$ on the five inputs (statsmodels OLS; the standardised coefficient "
+    doc.text(f"Multiple linear regression of $Phi$ on the five inputs (statsmodels OLS {cite('statsmodels')}; the standardised coefficient "
              "is $b dot s_x \\/ s_y$), Pearson's $r$ and Spearman's $rho$ with their p-values (scipy).")
     for drive in study.drives:
         name = UNIT_NAMES[drive.unit]
@@ -258,7 +259,7 @@ def sobol_section(doc: Document, study: StudyArtefacts, level: int = 1) -> None:
     """
     doc.heading("Sobol' indices", level)
     doc.text("First-order $S_i$ and total-effect $S_(T i)$ indices of the surrogate over uniform inputs. Estimates: "
-             "SALib's Saltelli/Jansen estimators on radial samples built from LHS, Halton and Sobol' base samples "
+             f"SALib's {cite('salib')} Saltelli {cite('saltelli')} and Jansen {cite('jansen')} estimators on radial samples built from LHS, Halton and Sobol' base samples "
              "of growing size $N$ (powers of two), with 95 % bootstrap intervals at the last $N$. The *exact* "
              "values come from the Legendre expansion of the quadratic ($V_i = a_i^2\\/3 + 4 q_i^2\\/45$, "
              "$V_(i j) = r_(i j)^2\\/9$) and are what the estimates converge to.")

@@ -12,6 +12,11 @@ def _unit(effect: str, param: str) -> str:
     return lit(get_effect(effect).param(param).unit)
 
 
+def effect_cell(name: str) -> str:
+    """An effect as a table cell: its title, and the name the config knows it by in raw text."""
+    return f"{lit(get_effect(name).title)} (`{name}`)"
+
+
 def _found(p: dict) -> str:
     """The found value with its sd and unit ('12.058 ± 0.068 K'), or why there is none."""
     if p["found"] is None:
@@ -50,7 +55,7 @@ def recovery_section(doc: Document, diag: dict, level: int) -> None:
     if not rec:
         return
     doc.heading("Against what was hidden", level)
-    rows = [[lit(p["effect"]), lit(p["param"]), f"{significant(p['hidden'], 5)} {_unit(p['effect'], p['param'])}",
+    rows = [[effect_cell(p["effect"]), f"`{p['param']}`", f"{significant(p['hidden'], 5)} {_unit(p['effect'], p['param'])}",
              _found(p), "–" if p["off_by_sd"] is None else f"{p['off_by_sd']:+.2f}",
              "yes" if p["recovered"] else "*no*"] for p in rec["parameters"]]
     doc.table(["effect", "parameter", "hidden in the data", "found (final, ± 1 sd)", "found − hidden (sd)",

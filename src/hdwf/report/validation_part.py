@@ -15,7 +15,7 @@ from hdwf.fe.hertz import ISO76_BALL_PRESSURE_MPA
 from hdwf.fe.relinearise import REDETECTED_LIMIT
 from hdwf.report.artefacts import CampaignArtefacts
 from hdwf.report.document import UNIT_NAMES, Document, fmt, lit, significant
-from hdwf.report.recovery_part import recovery_section
+from hdwf.report.recovery_part import effect_cell, recovery_section
 from hdwf.validation.effects import get as get_effect
 
 
@@ -44,7 +44,7 @@ def _detectability_rows(candidates: list[dict]) -> list[list[str]]:
     rows = []
     for c in candidates:
         sd = c["expected_rel_sd"]
-        rows.append([lit(c["effect"]), f"{c['realistic']:g} {lit(c['unit'])}",
+        rows.append([effect_cell(c["effect"]), f"{c['realistic']:g} {lit(c['unit'])}",
                      fmt(c["change_rms_arcmin"], 3), fmt(c["change_max_arcmin"], 3),
                      fmt(c["noise_to_show_arcmin"], 3), fmt(c["noise_to_calibrate_arcmin"], 3),
                      fmt(c["expected_delta_bic"], 1),
@@ -250,11 +250,12 @@ def signature_section(doc: Document, diag: dict, solved_final_rmse_arcmin: float
 def _round_table(doc: Document, rnd: dict) -> None:
     """Every candidate of one round, calibrated on top of that round's model."""
     cur = "the campaign's model" if not rnd["model_effects"] else "the model with " + ", ".join(
-        lit(e) for e in rnd["model_effects"])
+        lit(get_effect(e).title) for e in rnd["model_effects"])
     rows = []
     for r in rnd["ranking"]:
         (pname, val), = r["params"].items()
-        rows.append([lit(r["effect"]), f"{lit(pname)} = {_estimate(val, r.get('param_sd'))}"
+        unit = lit(get_effect(r["effect"]).param(pname).unit)
+        rows.append([effect_cell(r["effect"]), f"{_estimate(val, r.get('param_sd'))} {unit}"
                      + (" (bound)" if r.get("at_bound") else "") + (" (off)" if r.get("calibrated_off") else ""),
                      fmt(r["rmse_arcmin"], 4), fmt(r["delta_bic"], 1), fmt(r["loo_rmse_arcmin"], 4),
                      fmt(r["signature_match"], 2), "yes" if r["pays"] else "no",
@@ -303,7 +304,7 @@ def _runner_up(rnd: dict, best: dict, ties: list) -> str:
     nxt = min(others, key=lambda r: r["delta_bic"])
     gap = nxt["delta_bic"] - best["delta_bic"]
     strength = "very strong" if gap > 10 else "strong" if gap > 6 else "positive"
-    return (f" The runner-up, {lit(nxt['effect'])}, pays too (ΔBIC {fmt(nxt['delta_bic'], 1)}); the found effect's "
+    return (f" The runner-up, {lit(get_effect(nxt['effect']).title)}, pays too (ΔBIC {fmt(nxt['delta_bic'], 1)}); the found effect's "
             f"ΔBIC is {fmt(gap, 1)} lower, {strength} evidence for it over the runner-up (BIC differences of 6–10 "
             "are strong, above 10 very strong).")
 
