@@ -809,3 +809,14 @@ def test_the_fe_section_names_a_finer_flank_division(flank_refinement, said):
     assert ("a flank" in settings_text) == (said is not None)
     if said:
         assert "every flank divided into 2.5 times as many segments " + said in settings_text
+
+
+def test_a_calibrated_value_is_given_with_its_sd_in_plain_digits_and_its_unit():
+    """The sd to two significant figures (0.094, not 9.4e-02); no unit on a dimensionless value
+    (μ's '–') nor on a missing one (an effect calibrated off)."""
+    from hdwf.report.validation_part import _estimate
+
+    assert _estimate(10.95013, 0.09412, "K") == "10.9501 ± 0.094 K"
+    assert _estimate(0.3, 0.3201, "–") == "0.3000 ± 0.32"
+    assert _estimate(None, None, "N/mm²") == "–" and _estimate(float("nan"), 1.0, "K") == "–"
+    assert _estimate(48585.2406, 1818.72, "N·m/rad") == "48585.2406 ± 1800 N·m/rad"

@@ -19,16 +19,20 @@ from hdwf.report.recovery_part import effect_cell, recovery_section
 from hdwf.validation.effects import get as get_effect
 
 
-def _estimate(value: float, sd: float | None) -> str:
-    """A calibrated value with its standard deviation when the diagnosis gives one."""
-    return fmt(value, 4) + (f" ± {fmt(sd, 2)}" if sd is not None else "")
+def _estimate(value: float | None, sd: float | None, unit: str = "") -> str:
+    """A calibrated value with its standard deviation when the diagnosis gives one, and its unit
+    (none for a dimensionless one or a missing value)."""
+    if value is None or not math.isfinite(value):
+        return fmt(value)
+    said = fmt(value, 4) + (f" ± {significant(sd, 2)}" if sd is not None and math.isfinite(sd) else "")
+    return said + (f" {lit(unit)}" if unit not in ("", "1", "–", "-") else "")
 
 
 def _effect_sentence(r: dict) -> str:
     """A found effect in words: its title and calibrated parameter with unit."""
     eff = get_effect(r["effect"])
     (pname, val), = r["params"].items()
-    return f"*{lit(eff.title)}* ({lit(pname)} = {_estimate(val, r.get('param_sd'))} {lit(eff.param(pname).unit)})"
+    return f"*{lit(eff.title)}* ({lit(pname)} = {_estimate(val, r.get('param_sd'), eff.param(pname).unit)})"
 
 
 def _rung_values(effects_json: str) -> str:
@@ -254,8 +258,8 @@ def _round_table(doc: Document, rnd: dict) -> None:
     rows = []
     for r in rnd["ranking"]:
         (pname, val), = r["params"].items()
-        unit = lit(get_effect(r["effect"]).param(pname).unit)
-        rows.append([effect_cell(r["effect"]), f"{_estimate(val, r.get('param_sd'))} {unit}"
+        unit = get_effect(r["effect"]).param(pname).unit
+        rows.append([effect_cell(r["effect"]), _estimate(val, r.get("param_sd"), unit)
                      + (" (bound)" if r.get("at_bound") else "") + (" (off)" if r.get("calibrated_off") else ""),
                      fmt(r["rmse_arcmin"], 4), fmt(r["delta_bic"], 1), fmt(r["loo_rmse_arcmin"], 4),
                      fmt(r["signature_match"], 2), "yes" if r["pays"] else "no",
