@@ -305,7 +305,7 @@ def test_convergence_table_marks_changes_below_the_contact_tolerance():
     rows = _convergence_rows(conv, ("fine", "medium"))
     assert [r[-1] for r in rows] == ["yes", "*res.*", "*no*"]
     said = _below_resolution(conv)
-    assert said.startswith(", 1 more (*res.*)") and "0.0067 arcmin" in said
+    assert said.startswith(", and 1 more (*res.*)") and "0.0067 arcmin" in said
     assert _below_resolution(conv.drop(columns=["within_resolution", "resolution_arcmin"])) == ""
 
 
@@ -343,7 +343,7 @@ def test_ladder_is_held_against_the_bearing_rating():
     studies = {"preload": {"interference_m": 0.3}, "flank_layer": {"thickness_m": 3900.0}}
     lad["effects"] = ["{}", '{"preload": {"interference_m": 0.186}}']
     assert _bearing_sentence(lad, studies).endswith(
-        "The FE studies of Part II carry a larger allowance (0.3 m) within the rating because their flank layer "
+        "The FE studies of Part II carry a larger allowance (0.3 modules) within the rating because their flank layer "
         "takes up the overlap; this campaign's section has no layer, so its bearing holds the overlap.")
     assert "flank layer" not in _bearing_sentence(lad, {"preload": {"interference_m": 0.3}})
 
@@ -811,12 +811,35 @@ def test_the_fe_section_names_a_finer_flank_division(flank_refinement, said):
         assert "every flank divided into 2.5 times as many segments " + said in settings_text
 
 
-def test_a_calibrated_value_is_given_with_its_sd_in_plain_digits_and_its_unit():
-    """The sd to two significant figures (0.094, not 9.4e-02); no unit on a dimensionless value
-    (μ's '–') nor on a missing one (an effect calibrated off)."""
+def test_a_calibrated_value_is_given_to_the_digits_its_sd_supports_with_its_unit():
+    """The sd to two significant figures (0.094, not 9.4e-02) and the value to the same decimal
+    place (48600 ± 1800, not 48585.2406 ± 1818.72); no unit on a dimensionless value (μ's '–') nor
+    on a missing one (an effect calibrated off); without an sd, four significant figures."""
     from hdwf.report.validation_part import _estimate
 
-    assert _estimate(10.95013, 0.09412, "K") == "10.9501 ± 0.094 K"
-    assert _estimate(0.3, 0.3201, "–") == "0.3000 ± 0.32"
+    assert _estimate(10.95013, 0.09412, "K") == "10.950 ± 0.094 K"
+    assert _estimate(0.3, 0.3201, "–") == "0.30 ± 0.32"
     assert _estimate(None, None, "N/mm²") == "–" and _estimate(float("nan"), 1.0, "K") == "–"
-    assert _estimate(48585.2406, 1818.72, "N·m/rad") == "48585.2406 ± 1800 N·m/rad"
+    assert _estimate(48585.2406, 1818.72, "N·m/rad") == "48600 ± 1800 N·m/rad"
+    assert _estimate(1000.0, 745.12, "N/mm²") == "1000 ± 750 N/mm²"
+    assert _estimate(0.18612, None, "module") == "0.1861 module" and _estimate(2.5, float("inf"), "K") == "2.5 K"
+
+
+def test_the_sobol_table_says_which_n_each_sampler_reached():
+    """LHS runs on to 2^18 where Halton and Sobol' stop at 2^16: the table's estimates are at those N."""
+    import pandas as pd
+
+    from hdwf.report.paper_part import _last_n
+
+    sob = pd.DataFrame({"sampler": ["exact", "lhs", "lhs", "halton", "sobol"], "n": [0, 65536, 262144, 65536, 65536]})
+    assert _last_n(sob) == "LHS $N = 2^(18)$, Halton $N = 2^(16)$, Sobol' $N = 2^(16)$"
+
+
+def test_a_one_input_trend_names_the_input_by_its_symbol_and_says_it_is_alone():
+    """The signature's trend with d_mm (arcmin per µm) beside the regression test's coefficient of
+    d_mm (all five inputs at once) read as two verdicts on d that contradict each other."""
+    from hdwf.report.validation_part import _trend_label
+
+    assert _trend_label("d_mm") == "trend with $d$ alone (per µm of it)"
+    assert _trend_label("rFS_mm") == 'trend with $r_"FS"$ alone (per µm of it)'
+    assert _trend_label("torque_Nm") == "trend with torque\\_Nm"

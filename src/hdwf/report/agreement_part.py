@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from hdwf.report.artefacts import FeSettings, StudyArtefacts
-from hdwf.report.document import UNIT_NAMES, Document, fmt
+from hdwf.report.document import UNIT_NAMES, Document, fmt, unit_suffix
 from hdwf.report.figures import agreement_figure
 from hdwf.study.agreement import Agreement, ScatterBand, agreement, agreement_under_mesh_scatter
 from hdwf.study.knee import offset_slope_weights
@@ -20,8 +20,11 @@ from hdwf.validation.effects import get as get_effect
 
 def effects_text(effects) -> str:
     """``{name: {parameter: value}}`` in words: each effect's title and its parameter values."""
-    return "; ".join(f"{get_effect(name).title.lower()} ("
-                     + ", ".join(f"`{p}` = {v:g}" for p, v in params.items()) + ")"
+    def value(name, p, v):
+        unit = get_effect(name).param(p).unit
+        unit = unit + "s" if unit == "module" and v != 1 else unit
+        return f"{v:g}{unit_suffix(unit)} (`{p}`)"
+    return "; ".join(f"{get_effect(name).title.lower()}: " + ", ".join(value(name, p, v) for p, v in params.items())
                      for name, params in effects.items())
 
 
@@ -74,7 +77,8 @@ def _scatter_table(doc: Document, rows: list[list[str]]) -> None:
              "from the mesh changes measured on the same drive (the designs of the mesh-convergence study, default mesh against "
              "1.25× finer; Mesh convergence above) with a random sign, 2000 times (seeded). A target met in "
              "some draws and missed in others could be met or missed by mesh scatter of that size alone; the "
-             "verdict below gives the share of draws that meet each target missed, or met in fewer than 95 %. "
+             "verdict below gives, for each target missed or met in fewer than 95 % of the draws, the share of draws "
+             "that meet it. "
              "The bands are a lower bound on what the mesh can do: the change at 1.25× understates the default "
              "mesh's error (docs/fe-model.md, Mesh convergence: against meshes up to 3× finer the default mesh's "
              "$Phi$ lies 1–12 % high on the eight designs measured), and an error common to all designs moves "
@@ -198,7 +202,7 @@ def agreement_section(doc: Document, units: list[str], paper: StudyArtefacts, ou
         rows.append([UNIT_NAMES[u] + role, f"{len(both)} of {len(mine)}", fmt(a.spearman), fmt(a.spearman_p, 3), fmt(a.r2),
                      fmt(both["paper"].mean(), 3), fmt(both["ours"].mean(), 3), fmt(a.median_ratio, 2),
                      f"{fmt(ratio.min(), 2)}–{fmt(ratio.max(), 2)}"])
-    doc.table(["drive", "designs solved", "Spearman $rho$", "p", "$R^2$", "paper mean $Phi$", "our mean $Phi$",
+    doc.table(["drive", "designs solved", "Spearman $rho$", "p", "$R^2$", "paper mean $Phi$ (arcmin)", "our mean $Phi$ (arcmin)",
                "median ratio ours/paper", "ratio range"], rows,
               "Agreement of our $Phi$ with the paper's at the 27 design points of its Tables 4/5 ($R^2$ of a linear fit).")
     if scatter_rows:

@@ -62,8 +62,8 @@ def catalogue_section(doc: Document, units: list[str], paper: StudyArtefacts, fe
               f"CSF {cite('catalogue')}, ratio 50; ±T lies below $T_1$), against the median $Phi$ of each set of designs.")
     text = ("A catalogue unit is measured whole, cup, diaphragm, bearing and teeth, by its maker: no model of ours "
             "or the paper's made these numbers. Its backlash and hysteresis (of the order of an arcminute at $T_N$) "
-            "are left out here, so $2T slash K_1$ is the part a frictionless model should give. It is held fixed "
-            f"only so far: {LIMITS}.")
+            "are left out here, so $2T slash K_1$ is the part a frictionless model should give. Two limits "
+            f"of this check: {LIMITS}.")
     if "hd42" in checks and "hd120" in checks:
         small, large = checks["hd42"], checks["hd120"]
         c_lo, c_hi = size_ratio(small, large)
@@ -92,4 +92,4 @@ def _blind_sentence(small: CatalogueCheck, large: CatalogueCheck, settings: FeSe
             f"{fmt(max(away[n] for n in ours), 2)}×: calibrated on the {UNIT_NAMES[settings.calibrated_on]} table, our "
             f"model carries that calibration to {blind} closer to the size law than the paper's two tables keep it; "
             "so part of the blind drive's miss of the paper's level is the paper's own departure from that law "
-            "(the table gives each level against the real unit).")
+            "(the table above sets each level against the real unit's).")

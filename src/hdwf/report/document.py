@@ -60,6 +60,23 @@ def significant(value: float, digits: int = 4) -> str:
     return np.format_float_positional(value, precision=digits, unique=False, fractional=False, trim="-")
 
 
+def with_uncertainty(value: float, sd: float | None, digits: int = 2) -> str:
+    """``value ± sd`` with the sd to ``digits`` significant figures and the value to the same
+    decimal place (``48600 ± 1800``, ``10.950 ± 0.094``); without a finite, positive sd the value
+    to four significant figures."""
+    if sd is None or not np.isfinite(sd) or sd <= 0:
+        return significant(value, 4)
+    place = int(np.floor(np.log10(sd))) - (digits - 1)    # the decimal place of the last digit kept
+    if place >= 0:
+        return f"{round(value, -place):.0f} ± {round(sd, -place):.0f}"
+    return f"{value:.{-place}f} ± {sd:.{-place}f}"
+
+
+def unit_suffix(unit: str) -> str:
+    """A unit to follow a number (" N·m/rad"), nothing for a dimensionless one ("", "1", "–")."""
+    return "" if unit in ("", "1", "–", "-") else " " + lit(unit)
+
+
 def lit(text) -> str:
     """Literal text (a term such as ``d*D``, an id, a path) as typst markup.
 

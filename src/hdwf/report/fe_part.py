@@ -167,10 +167,9 @@ def _below_resolution(conv: pd.DataFrame) -> str:
     if "within_resolution" not in conv:
         return ""
     n = int((~conv["converged"].astype(bool) & _within_resolution(conv)).sum())
-    return (f", {n} more ({BELOW_RESOLUTION}) change by no more than the contact tolerance resolves "
-            f"({fmt(conv['resolution_arcmin'].iloc[0], 4)} arcmin: 4 × {TOL_GAP * 1000:g} µm over the base radius), "
-            "where 2 % of "
-            "their small $Phi$ is below it") if n else ""
+    return (f", and {n} more ({BELOW_RESOLUTION}) change by more than 2 % but by less than the solver resolves "
+            f"({fmt(conv['resolution_arcmin'].iloc[0], 4)} arcmin: 4 × {TOL_GAP * 1000:g} µm over the base radius; "
+            "2 % of their small $Phi$ is below that)") if n else ""
 
 
 def _where_it_misses(conv: pd.DataFrame) -> str:

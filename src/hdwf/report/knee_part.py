@@ -52,7 +52,7 @@ def knee_section(doc: Document, units: list[str], data_dir: Path, paper: StudyAr
                          fmt(slopes[name], 4)])
         rows[-1][-1] += f" ({fmt(slopes['ours'] / slopes['paper'], 2)}×)"
         panels[UNIT_NAMES[u]] = models
-    doc.table(["drive", "model", "floor $a$", "knee $s_0$ (µm)", "slope $b$ (arcmin/µm)", "weights $w_d, w_D, w_G$",
+    doc.table(["drive", "model", "floor $a$ (arcmin)", "knee $s_0$ (µm)", "slope $b$ (arcmin/µm)", "weights $w_d, w_D, w_G$",
                "$R^2$", "least-squares $d Phi slash d r_\"FS\"$ (arcmin/µm)"], rows,
               "Hinge fits $Phi = a + b max(0, s - s_0)$, $s = r_\"FS\" + r_\"CS\" + w_d Delta d slash 2 + "
               "w_D Delta D slash 2 + w_G Delta G_r slash 2$ (µm, $Delta$ from the paper's Table 3 nominal design, weights "
@@ -135,6 +135,6 @@ def rank_split_section(doc: Document, units: list[str], data_dir: Path, paper: S
     if below:
         text.append(f"On {' and '.join(below)} the target asks for more than the paper's own hinge gives: the "
                     "order within the paper's flat part, whose $Phi$ still rises with the clearances (the trend "
-                    "table), as a preloaded engagement that softens as the offsets relieve it would. A flat "
+                    "table), as it would if the preloaded engagement softened as the offsets relieve it. A flat "
                     "floor has no such order; a $Phi$ rising strictly with the clearance has.")
     doc.text(" ".join(text))

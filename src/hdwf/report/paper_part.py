@@ -221,6 +221,13 @@ def _sobol_rows(sob: pd.DataFrame, exact: pd.DataFrame) -> list[list[str]]:
     return rows
 
 
+def _last_n(sob: pd.DataFrame) -> str:
+    """Each sampler's last base sample size, e.g. ``LHS N = 2^18, Halton N = 2^16``."""
+    names = {"lhs": "LHS", "halton": "Halton", "sobol": "Sobol'"}
+    return ", ".join(f"{names[s]} $N = 2^({int(np.log2(sob[sob.sampler == s].n.max()))})$"
+                     for s in names if (sob.sampler == s).any())
+
+
 def _sobol_drive(doc: Document, drive: DriveArtefacts) -> None:
     """One drive's indices table, its check against the exact values, and its convergence figure."""
     name = UNIT_NAMES[drive.unit]
@@ -231,9 +238,10 @@ def _sobol_drive(doc: Document, drive: DriveArtefacts) -> None:
                                  else f"not converged ({v['reason']})") for k, v in meta["convergence"].items())
     doc.table(["parameter", "exact $S_i$", "exact $S_(T i)$", "LHS $S_i$", "LHS $S_(T i)$", "Halton $S_i$",
                "Halton $S_(T i)$", "Sobol' $S_i$", "Sobol' $S_(T i)$"], _sobol_rows(sob, exact),
-              f"{name}: indices, estimates at each sampler's last $N$. Stopping (largest change "
-              f"between successive $N$ below {meta['settings']['tolerance']}, $N >=$ {meta['settings']['n_min']}): "
-              f"{lit(stop)}.")
+              f"{name}: indices, estimates at each sampler's last $N$ ({_last_n(sob)}); ± is the half-width of the "
+              f"{100 * meta['settings'].get('conf_level', 0.95):g} % bootstrap interval. Stopping (largest change "
+              f"between successive $N$ below {meta['settings']['tolerance']}, $N >=$ {meta['settings']['n_min']}; "
+              f"a rule on the estimates' steps, not on the interval): {lit(stop)}.")
     sub = sob[(sob.sampler == "sobol") & (sob.n == SOBOL_CHECK_N)].set_index("parameter")
     if len(sub):
         params = list(PARAMETERS)
@@ -241,8 +249,8 @@ def _sobol_drive(doc: Document, drive: DriveArtefacts) -> None:
                   for k in ("S1", "ST"))
         doc.text(f"{name}: the Sobol'-sequence estimate at $N = {SOBOL_CHECK_N}$ differs from the exact indices "
                  f"by at most {fmt(err, 5)}.")
-    doc.figure(drive.sobol_png, f"{name}: convergence of $S_i$ and $S_(T i)$ with $N$ "
-               "(dotted LHS, dashed Halton, solid Sobol'); thick pale lines are the exact values; cf. the paper's Figs. 13/14.")
+    doc.figure(drive.sobol_png, f"{name}: convergence of $S_i$ (blue) and $S_(T i)$ (red) with $N$, one panel per "
+               "input (dotted LHS, dashed Halton, solid Sobol'); thick pale lines are the exact values; cf. the paper's Figs. 13/14.")
 
 
 def sobol_section(doc: Document, study: StudyArtefacts, level: int = 1) -> None:

@@ -4,7 +4,7 @@ report's summary."""
 
 from __future__ import annotations
 
-from hdwf.report.document import Document, lit, significant
+from hdwf.report.document import Document, lit, significant, with_uncertainty
 from hdwf.validation.effects import get as get_effect
 
 
@@ -21,9 +21,8 @@ def _found(p: dict) -> str:
     """The found value with its sd and unit ('12.058 ± 0.068 K'), or why there is none."""
     if p["found"] is None:
         return "not named"
-    sd = f" ± {significant(p['sd'], 2)}" if p["sd"] is not None else ""
     told = "" if p["named"] else " (calibrated as told, not named)"
-    return f"{significant(p['found'], 5)}{sd} {_unit(p['effect'], p['param'])}{told}"
+    return f"{with_uncertainty(p['found'], p['sd'])} {_unit(p['effect'], p['param'])}{told}"
 
 
 def recovery_summary(rec: dict) -> str:

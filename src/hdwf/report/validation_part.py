@@ -9,12 +9,13 @@ import math
 
 import pandas as pd
 
+from hdwf import PARAMETER_COLUMNS, PARAMETERS
 from hdwf.common.io import read_json
 from hdwf.drive.design import MeshSettings
 from hdwf.fe.hertz import ISO76_BALL_PRESSURE_MPA
 from hdwf.fe.relinearise import REDETECTED_LIMIT
 from hdwf.report.artefacts import CampaignArtefacts
-from hdwf.report.document import UNIT_NAMES, Document, fmt, lit, significant
+from hdwf.report.document import UNIT_NAMES, Document, fmt, lit, math_label, significant, unit_suffix, with_uncertainty
 from hdwf.report.recovery_part import effect_cell, recovery_section
 from hdwf.validation.effects import get as get_effect
 
@@ -24,8 +25,7 @@ def _estimate(value: float | None, sd: float | None, unit: str = "") -> str:
     (none for a dimensionless one or a missing value)."""
     if value is None or not math.isfinite(value):
         return fmt(value)
-    said = fmt(value, 4) + (f" ± {significant(sd, 2)}" if sd is not None and math.isfinite(sd) else "")
-    return said + (f" {lit(unit)}" if unit not in ("", "1", "–", "-") else "")
+    return with_uncertainty(value, sd) + unit_suffix(unit)
 
 
 def _effect_sentence(r: dict) -> str:
@@ -48,7 +48,7 @@ def _detectability_rows(candidates: list[dict]) -> list[list[str]]:
     rows = []
     for c in candidates:
         sd = c["expected_rel_sd"]
-        rows.append([effect_cell(c["effect"]), f"{c['realistic']:g} {lit(c['unit'])}",
+        rows.append([effect_cell(c["effect"]), f"{c['realistic']:g}{unit_suffix(c['unit'])}",
                      fmt(c["change_rms_arcmin"], 3), fmt(c["change_max_arcmin"], 3),
                      fmt(c["noise_to_show_arcmin"], 3), fmt(c["noise_to_calibrate_arcmin"], 3),
                      fmt(c["expected_delta_bic"], 1),
@@ -199,17 +199,25 @@ _TERM_LABELS = {"bias": "level bias", "slope": "slope on torque (compliance)",
                 "dead_band": "dead band at zero torque (play width)", "loop_width": "loop width between branches"}
 
 
+def _trend_label(column: str) -> str:
+    """A one-input trend's row: the input by its symbol (``d_mm`` -> $d$), its slope per µm of it."""
+    by_column = dict(zip(PARAMETER_COLUMNS, PARAMETERS))
+    if column not in by_column:
+        return lit(f"trend with {column}")
+    return f"trend with {math_label(by_column[column])} alone (per µm of it)"
+
+
 def _signature_rows(sig: dict) -> list[list[str]]:
     """Per term of the residual's signature: its value (also in arcmin), se and significance; then the noise."""
     rows = []
     for t in sig["terms"]:
-        label = _TERM_LABELS.get(t["name"]) or f"trend with {t['name'].removeprefix('trend_')}"
+        label = lit(_TERM_LABELS.get(t["name"]) or "") or _trend_label(t["name"].removeprefix("trend_"))
         value = f"{fmt(t['value'], 4)} {t['unit']}"
         if t["unit"] != "arcmin":
             value += f" ({fmt(t['value_arcmin'], 4)} arcmin)"
         if t.get("r_squared") is not None:
             value += f", R² {t['r_squared']:.2f}"
-        rows.append([lit(label), lit(value), lit(f"{fmt(t['se'], 4)} {t['unit']}"),
+        rows.append([label, lit(value), lit(f"{fmt(t['se'], 4)} {t['unit']}"),
                      "yes" if t["significant"] else "no"])
     n = sig["noise"]
     stated = n.get("stated_median_arcmin")
@@ -358,7 +366,7 @@ def _layer_note(over: pd.DataFrame, studies_effects: dict | None) -> str:
         return ""
     theirs = effects["preload"]["interference_m"]
     size = "a larger allowance" if theirs > first["preload"]["interference_m"] else "an allowance"
-    return (f" The FE studies of Part II carry {size} ({theirs:g} m) "
+    return (f" The FE studies of Part II carry {size} ({theirs:g} modules) "
             "within the rating because their flank layer takes up the overlap; this campaign's section has no "
             "layer, so its bearing holds the overlap.")
 
@@ -405,6 +413,12 @@ def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2,
     _where_it_fails(doc, diag, campaign, level + 1)
     signature_section(doc, diag, float(ladder["rmse_arcmin"].iloc[-1]))
     doc.heading("Which effect is missing", level + 1)
+    doc.text("How to read the rounds: each round calibrates every candidate on the specimens' tabulated solves "
+             "(interpolated between the candidate's grid values); its value ± 1 standard uncertainty comes from "
+             "that fit. An effect a round finds is then re-solved near its estimate on every specimen before the "
+             "next round, and the final model is calibrated on such solves too (the notes after the rounds), so "
+             "its values and RMSE can differ from a round's table by more than that uncertainty: the table's "
+             "interpolation error is not in it. The ladder below holds the re-solved values.")
     for rnd in diag["rounds"]:
         _round_table(doc, rnd)
         doc.text(_round_verdict(rnd))

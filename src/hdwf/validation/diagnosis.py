@@ -333,8 +333,11 @@ def _noise(obs: pd.DataFrame, g: _GreedySearch, check: NoiseCheck) -> tuple[floa
                                               f"stated uncertainty, {noise:.3g} arcmin RMS, is far below it")
     if noise is not None:
         return noise, noise, "the noise stated in the measurement file"
-    sigma = float(np.sqrt(g.fit.rss / max(len(g.data.D) - len(g.on), 1)))
-    return None, sigma, "the residual of the final model (no noise stated: an upper bound on the noise)"
+    dof = max(len(g.data.D) - len(g.on), 1)
+    sigma = float(np.sqrt(g.fit.rss / dof))
+    return None, sigma, (f"no noise is stated: the residual of the search's final fit on the tabulated solves, "
+                         f"sqrt(RSS / {dof}) over {len(g.data.D)} values less {len(g.on)} calibrated parameters, an "
+                         "upper bound on the noise; the ladder's re-solved RMSE can differ")
 
 
 def _signature(form: str, base_points: pd.DataFrame, g: _GreedySearch, final_rmse_arcmin: float) -> ResidualSignature:
