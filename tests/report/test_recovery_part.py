@@ -42,6 +42,8 @@ def test_the_chapter_holds_each_found_value_against_the_hidden_one():
     assert rows["Flexspline cup torsion (`fs_cup_torsion`)"][1:] == ["50000 N·m/rad", "48600 ± 1800 N·m/rad", "-0.77", "yes"]
     text = next(b["text"] for b in doc.blocks if b["type"] == "text")
     assert text.startswith("The campaign recovered every hidden effect (2 of 2 recovered, each within 0.86 sd)")
+    # the data came from the model it is fitted with: a check of the search, not of the physics
+    assert "the same FE model the campaign fits, so this checks the search and its calibration" in text
 
 
 def test_a_missed_effect_makes_the_summary_row_a_miss(tmp_path):

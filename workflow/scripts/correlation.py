@@ -3,6 +3,7 @@ import logging
 
 from _helpers import mock_snakemake, setup
 
+from hdwf.report.document import UNIT_NAMES
 from hdwf.stages.stats import correlation_stage
 
 if "snakemake" not in globals():  # run by hand, e.g. to debug one step (see _helpers.mock_snakemake)
@@ -11,5 +12,5 @@ if "snakemake" not in globals():  # run by hand, e.g. to debug one step (see _he
 prov = setup(snakemake)
 w = snakemake.wildcards
 table = correlation_stage(snakemake.input[0], snakemake.output.table, snakemake.output.figure,
-                          f"{w.study} / {w.unit}: lost motion against each input", prov)
+                          f"study '{w.study}', {UNIT_NAMES[w.unit]}: lost motion against each input", prov)
 logging.info("\n%s", table.to_string())

@@ -63,5 +63,10 @@ def recovery_section(doc: Document, diag: dict, level: int) -> None:
               f"by the search, and its final calibrated value within {rec['within_sd']:g} standard uncertainties of "
               "the hidden one (a value without a finite uncertainty is not counted).")
     order = diag.get("verdict", {}).get("found_in_order") or []
+    mesh = diag.get("mesh") or {}
+    on = (f" on the campaign's own mesh ({mesh['elements_over_height']} × {mesh['elements_over_thickness']} "
+          "elements a tooth)" if "elements_over_height" in mesh else "")
     doc.text(f"{_verdict(rec)} ({recovery_summary(rec)}); it named "
-             + (", then ".join(lit(o) for o in order) if order else "nothing") + ".")
+             + (", then ".join(lit(o) for o in order) if order else "nothing") + ". "
+             f"The data were made by the same FE model the campaign fits{on}, so this checks the search and "
+             "its calibration against the noise, not the model's physics: only bench data can test that.")

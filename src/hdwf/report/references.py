@@ -23,7 +23,7 @@ REFERENCES: tuple[Reference, ...] = (
                        "5057 (2021), doi:10.3390/ma14175057. Its Tables 1–5 are the project's `data/paper`."),
     Reference("catalogue", "Harmonic Drive: CSF and CSG series component sets and units, the makers' catalogue "
                            "(torsional stiffness $K_1$ below the torque $T_1$, ratio 50; `hdwf.study.catalogue`)."),
-    Reference("iso76", "ISO 76: Rolling bearings — Static load ratings (4200 MPa contact pressure for ball bearings "
+    Reference("iso76", "ISO 76:2006: Rolling bearings — Static load ratings (4200 MPa contact pressure for ball bearings "
                        "other than self-aligning)."),
     Reference("celik", "I. B. Celik, U. Ghia, P. J. Roache, C. J. Freitas, H. Coleman, P. E. Raad: Procedure for "
                        "estimation and reporting of uncertainty due to discretization in CFD applications. "
