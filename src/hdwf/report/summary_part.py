@@ -54,8 +54,14 @@ def _fe_model(report: ReportInputs) -> list[Finding]:
             if drive.convergence:
                 conv = pd.read_parquet(drive.convergence)
                 n_ok = int(conv["converged"].sum())
+                change = conv["rel_change_fine"] * 100
+                gci = (f"; median GCI {fmt(conv['gci_fine'].median() * 100, 1)} %"
+                       if "gci_fine" in conv and conv["gci_fine"].notna().any() else "")
                 found.append(Finding(f"{UNIT_NAMES[drive.unit]}: designs of `{study.name}` within 2 % on a 1.25× "
-                                     "finer mesh", f"{n_ok} of {len(conv)}", "all", "Part II, Mesh convergence",
+                                     "finer mesh (the change median and largest; the GCI of the representative "
+                                     "designs, an error estimate)",
+                                     f"{n_ok} of {len(conv)} (median {fmt(change.median(), 2)} %, largest "
+                                     f"{fmt(change.max(), 2)} %{gci})", "all", "Part II, Mesh convergence",
                                      n_ok == len(conv)))
     at_paper = [s for s in report.fe_studies if s.designs == "paper"]
     if not (at_paper and report.paper_studies):
