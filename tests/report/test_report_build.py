@@ -846,3 +846,22 @@ def test_a_one_input_trend_names_the_input_by_its_symbol_and_says_it_is_alone():
     assert _trend_label("d_mm") == "trend with $d$ alone (per µm of it)"
     assert _trend_label("rFS_mm") == 'trend with $r_"FS"$ alone (per µm of it)'
     assert _trend_label("torque_Nm") == "trend with torque\\_Nm"
+
+
+def test_the_knee_figure_is_linear_unless_a_panels_phi_spans_a_decade(monkeypatch):
+    """A hinge is two straight pieces on a linear axis: the paper's 0.18–1.49 arcmin (8×) stays linear;
+    a locked design at 0.02 beside open ones at 1.5 (75×) needs the log axis to be seen."""
+    import numpy as np
+
+    from hdwf.report import figures
+    from hdwf.study.knee import HingeFit
+
+    drawn = []
+    monkeypatch.setattr(figures, "_save", lambda fig, path: drawn.append(fig))
+    s = np.linspace(0, 50, 27)
+    fit = HingeFit(0.18, 0.05, 25.0, (0.0, 0.0, 0.0), 1.0, 27)
+    phi = 0.18 + 0.05 * np.maximum(0, s - 25)            # 0.18 to 1.43 arcmin: 7.9×
+    locked = np.where(s < 25, 0.02, phi)                 # 0.02 to 1.43: 72×
+    figures.knee_figure({"HD 42": {"paper": (s, phi, fit)}}, "t", "a.png")
+    figures.knee_figure({"HD 42": {"ours": (s, locked, fit)}}, "t", "b.png")
+    assert [fig.axes[0].get_yscale() for fig in drawn] == ["linear", "log"]

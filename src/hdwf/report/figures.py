@@ -242,7 +242,9 @@ def agreement_figure(pairs: dict[str, tuple[np.ndarray, np.ndarray]], title: str
 
 
 def knee_figure(panels: dict[str, dict[str, tuple[np.ndarray, np.ndarray, HingeFit]]], title: str, path) -> None:
-    """Φ against the clearance s with each model's hinge fit, one panel per drive, log Φ axis.
+    """Φ against the clearance s with each model's hinge fit, one panel per drive; a log Φ axis
+    only where a panel's Φ spans more than ten times (a locked design beside open ones), else
+    linear, where a hinge reads as the two straight pieces it is.
 
     Parameters
     ----------
@@ -260,8 +262,11 @@ def knee_figure(panels: dict[str, dict[str, tuple[np.ndarray, np.ndarray, HingeF
             ax.plot(xs[ys > 0], ys[ys > 0], "-", color=colour, lw=1)
             if fit.knee_um > s.min():
                 ax.axvline(fit.knee_um, color=colour, ls=":", lw=0.8)
-        ax.set_yscale("log")
-        ax.set_xlabel("clearance s = r_FS + r_CS + weighted radial shortfall (µm)")
+        phis = np.concatenate([phi for _, phi, _ in models.values()])
+        phis = phis[np.isfinite(phis) & (phis > 0)]
+        if len(phis) and phis.max() > 10 * phis.min():
+            ax.set_yscale("log")
+        ax.set_xlabel("clearance $s = r_{FS} + r_{CS}$ + weighted radial shortfall (µm)")
         ax.set_ylabel("Φ (arcmin)")
         ax.set_title(label, fontsize=10)
         ax.legend(fontsize=7)
