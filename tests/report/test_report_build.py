@@ -865,3 +865,16 @@ def test_the_knee_figure_is_linear_unless_a_panels_phi_spans_a_decade(monkeypatc
     figures.knee_figure({"HD 42": {"paper": (s, phi, fit)}}, "t", "a.png")
     figures.knee_figure({"HD 42": {"ours": (s, locked, fit)}}, "t", "b.png")
     assert [fig.axes[0].get_yscale() for fig in drawn] == ["linear", "log"]
+
+
+def test_the_constants_table_sets_both_drives_side_by_side():
+    """One row a quantity (the paper's 240 teeth on both, the module 0.18 against 0.514 mm), not each
+    source text twice; E and ν, common to both, in both columns."""
+    from hdwf.drive.geometry import assumptions_table
+    from hdwf.report.fe_part import _assumption_rows
+
+    rows = {r[0]: r[1:] for r in _assumption_rows(assumptions_table())}
+    assert len(rows) == 21
+    assert rows["`z_fs`"] == ["240", "240", "paper Table 1"]
+    assert rows["`module`"][:2] == ["0.18 mm", "0.514 mm"]
+    assert rows["`E, ν`"][:2] == ["210000 MPa, 0.3", "210000 MPa, 0.3"]

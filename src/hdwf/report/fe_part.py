@@ -28,6 +28,16 @@ from hdwf.report.references import cite
 from hdwf.study.paper import load_published
 
 
+def _assumption_rows(assumptions: list[dict]) -> list[list[str]]:
+    """One row per quantity with both drives' values side by side (a value for both in one cell)."""
+    by_name: dict[str, dict] = {}
+    for a in assumptions:
+        row = by_name.setdefault(a["name"], {"source": a["source"]})
+        row[a["unit"]] = a["value"]
+    return [[f"`{name}`", lit(r.get("HD 42", r.get("both", "–"))), lit(r.get("HD 120", r.get("both", "–"))),
+             lit(r["source"])] for name, r in by_name.items()]
+
+
 def fe_model_section(doc: Document, assumptions: tuple[dict, ...], pictures: dict[str, Path],
                      settings: FeSettings, level: int = 1) -> None:
     """The FE model in words, its settings, every assumed value and the deformed-mesh pictures.
@@ -69,8 +79,7 @@ def fe_model_section(doc: Document, assumptions: tuple[dict, ...], pictures: dic
                     "blind prediction with the same values" if settings.calibrated_on else "")
                  + " (`docs/fe-model.md`, \"The studies' model\"). The validation campaigns of Part III start "
                  "from the bare section instead." + _layer_sentence(settings))
-    rows = [[lit(a["unit"]), lit(a["name"]), lit(a["value"]), lit(a["source"])] for a in assumptions]
-    doc.table(["drive", "quantity", "value", "source or reason"], rows,
+    doc.table(["quantity", "HD 42", "HD 120", "source or reason"], _assumption_rows(assumptions),
               "The constants of both drives: those the paper gives, with its table, and those it does not, "
               "with the reason for the value assumed.")
     preloaded = (settings.effects.get("preload") or {}).get("interference_m", 0) > 0
