@@ -359,9 +359,9 @@ def test_ladder_gives_the_solvers_own_contact_check():
                         "max_penetration_redetected_um": [0.012, 0.0481, float("nan")],
                         "specimens_contact_unchecked": [0, 0, 0]})
     said = _contact_check_sentence(lad)
-    assert "at most 0.0481 µm" in said and "over every rung's solves (rung 1;" in said and "beyond 0.5 µm" in said
+    assert "at most 0.0481 µm" in said and "over every rung's solves (at rung 1;" in said and "more than 0.5 µm is marked failed" in said
     said = _contact_check_sentence(lad.assign(specimens_contact_unchecked=[27, 0, 3]))
-    assert "over the solves that made the check (rung 1;" in said and "every rung" not in said
+    assert "over the solves that made the check (at rung 1;" in said and "every rung" not in said
     assert "*Not made* for rung 0 (baseline) on 27 specimens; rung 2 (with preload, coning) on 3 specimens" in said
     none = lad.assign(max_penetration_redetected_um=float("nan"), specimens_contact_unchecked=[27, 27, 27])
     assert _contact_check_sentence(none).startswith("The solver's check from scratch at ±T was not made for rung 0")

@@ -264,7 +264,8 @@ def _unsolved_overlap(lm: pd.DataFrame) -> str:
     over = lm["overlap_outside_zones_um"]
     return (f"Teeth outside the solved zones overlap at the mount in {int((over > 0).sum())} of {len(lm)} "
             f"designs, by up to {fmt(over.max(), 1)} µm (median {fmt(over.median(), 1)} µm): with the assumed "
-            "involute tips, FS and CS tips cross on the way out of mesh, unseen (tip relief, docs/fe-model.md). ")
+            "involute tips, FS and CS tips cross where the teeth leave the engagement, where the solver does not "
+            "watch them (tip relief, docs/fe-model.md). ")
 
 
 def curves_section(doc: Document, study: StudyArtefacts, tmp: Path, level: int = 1) -> None:

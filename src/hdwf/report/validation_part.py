@@ -352,7 +352,8 @@ def _contact_check_sentence(ladder: pd.DataFrame) -> str:
     return (f"The solver's own check: the tooth pairs, re-found from scratch at ±T, sink at most "
             f"{fmt(worst['max_penetration_redetected_um'], 4)} µm into each other over "
             + ("every rung's solves" if not missing else "the solves that made the check")
-            + f" (rung {int(worst['rung'])}; a solve fails beyond {REDETECTED_LIMIT * 1000:g} µm)."
+            + f" (at rung {int(worst['rung'])}; a solve that leaves more than {REDETECTED_LIMIT * 1000:g} µm "
+            "is marked failed)."
             + (f" *Not made* for {missing} ({why})." if missing else ""))
 
 
