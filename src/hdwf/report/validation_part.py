@@ -211,7 +211,8 @@ def _signature_rows(sig: dict) -> list[list[str]]:
     """Per term of the residual's signature: its value (also in arcmin), se and significance; then the noise."""
     rows = []
     for t in sig["terms"]:
-        label = lit(_TERM_LABELS.get(t["name"]) or "") or _trend_label(t["name"].removeprefix("trend_"))
+        name = t["name"]
+        label = lit(_TERM_LABELS[name]) if name in _TERM_LABELS else _trend_label(name.removeprefix("trend_"))
         value = f"{fmt(t['value'], 4)} {t['unit']}"
         if t["unit"] != "arcmin":
             value += f" ({fmt(t['value_arcmin'], 4)} arcmin)"
