@@ -224,8 +224,8 @@ def _sobol_rows(sob: pd.DataFrame, exact: pd.DataFrame) -> list[list[str]]:
 def _last_n(sob: pd.DataFrame) -> str:
     """Each sampler's last base sample size, e.g. ``LHS N = 2^18, Halton N = 2^16``."""
     names = {"lhs": "LHS", "halton": "Halton", "sobol": "Sobol'"}
-    return ", ".join(f"{names[s]} $N = 2^({int(np.log2(sob[sob.sampler == s].n.max()))})$"
-                     for s in names if (sob.sampler == s).any())
+    last = sob.groupby("sampler").n.max()
+    return ", ".join(f"{names[s]} $N = 2^({int(np.log2(last[s]))})$" for s in names if s in last)
 
 
 def _sobol_drive(doc: Document, drive: DriveArtefacts) -> None:

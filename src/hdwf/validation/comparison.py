@@ -155,7 +155,7 @@ def residual_tests(points: pd.DataFrame) -> pd.DataFrame:
         for name, p in zip(np.array(PARAMETER_COLUMNS)[varying], fit.pvalues[1:]):
             rows.append({"test": f"error ~ inputs: {name}", "statistic": float("nan"), "p_value": float(p),
                          "meaning": f"the error changes with {name} with the other inputs held "
-                                    "(a coefficient of the regression on all five, not a trend with it alone)"})
+                                    "(a coefficient of the regression on all the varying inputs, not a trend with it alone)"})
     if len(points) > 5 and points["S"].std() > 0:
         base = sm.OLS(points["D"].to_numpy(float), sm.add_constant(points["S"].to_numpy(float))).fit()
         reset = linear_reset(base, power=3, use_f=True)
