@@ -596,8 +596,10 @@ def test_the_summary_gathers_each_parts_headline_figure(named_inputs, tmp_path):
     (tmp_path / "diagnosis.json").write_text(json.dumps({"unit": "hd42", "noise_arcmin": 0.19,
                                                          "verdict": {"found_in_order": ["preload", "fs_cup_torsion"]}}))
     pd.DataFrame({"rmse_arcmin": [8.96, 0.52, 0.194]}).to_parquet(tmp_path / "ladder.parquet")
+    # measured 0.6 and 0.8 arcmin: RMS √((0.36 + 0.64) / 2) = 0.7071, the last rung 0.194 / 0.7071 = 27 % of it
+    pd.DataFrame({"D": [0.6, 0.8]}).to_parquet(tmp_path / "points.parquet")
     campaign = CampaignArtefacts("paper_hd42", tmp_path / "diagnosis.json", tmp_path / "ladder.parquet",
-                                 *(tmp_path / "x.png",) * 3)
+                                 *(tmp_path / "x.png",) * 3, points=tmp_path / "points.parquet")
     report = ReportInputs((paper, ours), (campaign,), DATA,
                           FeSettings(MeshSettings(), 5, effects={"preload": {"interference_m": 0.3}}, calibrated_on="hd42"),
                           (), PROVENANCE)
@@ -620,7 +622,8 @@ def test_the_summary_gathers_each_parts_headline_figure(named_inputs, tmp_path):
     catalogue = by_what["HD 42 (calibrated): median $Phi$ over a catalogue unit's $2T slash K_1$ (the paper's in brackets)"]
     assert catalogue[:3] == [f"{1.2 * median / 0.81487:.2f}× ({median / 0.81487:.2f}×)", "CSF-17: 0.815 arcmin", "–"]
     ladder = next(r for r in rows if r[0].startswith("`paper_hd42` (HD 42)"))
-    assert ladder[1:4] == ["8.960 → 0.194 arcmin (46.19×)", "stated noise 0.190 arcmin", "–"]
+    assert ladder[1:4] == ["8.960 → 0.194 arcmin (46.19×)", "stated noise 0.190 arcmin; the measured values' RMS "
+                           "0.707 arcmin, the last rung 27 % of it", "–"]
     assert ladder[0].endswith(f"found preload, {lit('fs_cup_torsion')}")
     pd.DataFrame({"rmse_arcmin": [8.96, 0.52, 0.194], "specimens_above_iso76": [0, 19, 19],
                   "specimens_checked": [27, 27, 27]}).to_parquet(tmp_path / "ladder.parquet")

@@ -130,6 +130,7 @@ CAMPAIGN_ARTEFACTS = {
     "measured_png": "measured_vs_predicted.png",
     "residuals_png": "residuals.png",
     "ladder_png": "ladder.png",
+    "points": "points.parquet",
 }
 
 

@@ -58,7 +58,8 @@ class StudyArtefacts:
 
 @dataclass(frozen=True)
 class CampaignArtefacts:
-    """A validation campaign's artefacts (``results/validation/{campaign}/``)."""
+    """A validation campaign's artefacts (``results/validation/{campaign}/``); ``points`` is the
+    comparison table (one row per observation, the measured value in ``D``), None where not given."""
 
     name: str
     diagnosis: Path
@@ -66,6 +67,7 @@ class CampaignArtefacts:
     measured_png: Path
     residuals_png: Path
     ladder_png: Path
+    points: Path | None = None
 
 
 @dataclass(frozen=True)

@@ -13,11 +13,12 @@ from hdwf.common.io import read_json
 from hdwf.fe.hertz import ISO76_BALL_PRESSURE_MPA
 from hdwf.report.agreement_part import (AGREEMENT_TARGETS, TARGET_BOUNDS, at_risk_note, drive_role,
                                         fe_mesh_changes, mesh_scatter, paper_agreement)
-from hdwf.report.artefacts import ReportInputs
+from hdwf.report.artefacts import CampaignArtefacts, ReportInputs
 from hdwf.report.catalogue_part import catalogue_checks, catalogue_phi_text, span_text
 from hdwf.report.document import UNIT_NAMES, Document, fmt, lit
 from hdwf.report.paper_part import largest_sobol_difference
 from hdwf.report.recovery_part import hidden_text, recovery_summary
+from hdwf.report.validation_part import measured_rms
 
 
 @dataclass(frozen=True)
@@ -106,6 +107,16 @@ def _over_rating(ladder: pd.DataFrame) -> str:
             f"{int(last['specimens_above_iso76'])} of {int(last['specimens_checked'])} specimens")
 
 
+def _data_scale(campaign: CampaignArtefacts, last_rmse: float) -> str:
+    """The measured values' RMS and the last rung's RMSE as a share of it: a fall of the error
+    says little unless the error left is small against what was measured."""
+    scale = measured_rms(campaign)
+    if scale is None:
+        return ""
+    share = f", the last rung {100 * last_rmse / scale:.2g} % of it" if np.isfinite(last_rmse) else ""
+    return f"; the measured values' RMS {fmt(scale, 3)} arcmin{share}"
+
+
 def _campaigns(report: ReportInputs) -> list[Finding]:
     found = []
     for campaign in report.campaigns:
@@ -116,10 +127,10 @@ def _campaigns(report: ReportInputs) -> list[Finding]:
         value = (f"{fmt(rmse[0], 3)} → {fmt(rmse[-1], 3)} arcmin ({fmt(rmse[0] / rmse[-1], 2)}×)"
                  if np.isfinite(rmse[[0, -1]]).all() else "a rung's solve failed: no fall to give")
         noise = diag.get("noise_arcmin")
+        against = f"stated noise {fmt(noise, 3)} arcmin" if noise else "no noise stated"
         found.append(Finding(f"`{campaign.name}` ({UNIT_NAMES[diag['unit']]}): RMSE, bare model to the last rung; "
                              f"found {', '.join(lit(n) for n in named) if named else 'nothing'}"
-                             + _over_rating(ladder), value,
-                             f"stated noise {fmt(noise, 3)} arcmin" if noise else "no noise stated",
+                             + _over_rating(ladder), value, against + _data_scale(campaign, rmse[-1]),
                              f"Part III, Campaign '{lit(campaign.name)}'"))
         if diag.get("recovery"):
             found.append(Finding(f"`{campaign.name}` ({UNIT_NAMES[diag['unit']]}): the effects hidden in its "
