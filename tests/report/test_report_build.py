@@ -551,6 +551,21 @@ def test_the_ladder_figure_names_each_rungs_effect_and_shows_a_large_fall_on_a_l
         plt.close(fig)
 
 
+def test_the_ladder_table_reads_each_rung_in_words_with_the_effect_it_adds():
+    """The rungs are cumulative ('with preload, fs_cup_torsion'): the table names what each adds by
+    the effect's own title, the config name beside it, and the campaign model by its effects."""
+    from hdwf.report.document import lit
+    from hdwf.report.validation_part import rung_in_words
+    from hdwf.validation.effects import get as get_effect
+
+    assert rung_in_words("baseline", []) == "our FE model, no effect switched on"
+    assert rung_in_words("with preload, fs_cup_torsion", []) == (
+        f"+ {get_effect('fs_cup_torsion').title} ({lit('fs_cup_torsion')})")
+    assert rung_in_words("campaign model", ["preload"]) == (
+        f"the campaign's model: {get_effect('preload').title} ({lit('preload')})")
+    assert get_effect("fs_cup_torsion").title == "Flexspline cup torsion"
+
+
 def test_a_failed_rung_is_left_out_of_the_ladder_figure_not_labelled_nan(monkeypatch, tmp_path):
     """A rung whose solve failed has no RMSE (``ladder_table``): the figure labels the two rungs that
     have one and still puts the fall from 8.96 to 0.194 (46x) on a log axis."""

@@ -44,6 +44,17 @@ def _rung_values(effects_json: str) -> str:
     return "; ".join(parts) if parts else "–"
 
 
+def rung_in_words(model: str, fixed: list[str]) -> str:
+    """A ladder rung's label read plainly: what the rung's model is, or what it adds to the rung
+    before (``ladder_variants`` labels the found rungs 'with a, b, c', cumulative)."""
+    if model == "baseline":
+        return "our FE model, no effect switched on"
+    if model == "campaign model":
+        return "the campaign's model: " + ", ".join(f"{get_effect(e).title} ({lit(e)})" for e in fixed)
+    added = model[len("with "):].split(", ")[-1] if model.startswith("with ") else model
+    return f"+ {get_effect(added).title} ({lit(added)})"
+
+
 def _detectability_rows(candidates: list[dict]) -> list[list[str]]:
     """Per candidate: its realistic value, the change it makes, the noise it needs, ΔBIC and sd."""
     rows = []
@@ -441,10 +452,11 @@ def campaign_chapter(doc: Document, campaign: CampaignArtefacts, level: int = 2,
     detectability_section(doc, diag, level + 1)
     doc.heading("Adding it: the error ladder", level + 1)
     doc.table(["rung", "model", "values solved with", "RMSE", "bias", "largest |E|", "ΔBIC"],
-              [[str(r["rung"]), lit(r["model"]), _rung_values(r["effects"]), fmt(r["rmse_arcmin"], 4),
+              [[str(r["rung"]), rung_in_words(r["model"], list(diag["model"]["fixed"])), _rung_values(r["effects"]), fmt(r["rmse_arcmin"], 4),
                 fmt(r["bias_arcmin"], 4), fmt(r["max_abs_arcmin"], 4), fmt(r["delta_bic"], 1)]
                for r in ladder.to_dict("records")],
-              "Each rung re-solved with the FE model (not interpolated): the found effects switched on at their "
+              "Each rung re-solved with the FE model (not interpolated), each adding the effect it names to the rung "
+              "before: the found effects switched on at their "
               "final calibrated values (after any recalibration on actual solves, so they and the RMSE can differ "
               "from the rounds' table estimates above). ΔBIC against the first rung."
               + (f" Stated noise: {fmt(noise, 4)} arcmin." if noise else ""))
