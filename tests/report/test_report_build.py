@@ -559,10 +559,10 @@ def test_the_ladder_table_reads_each_rung_in_words_with_the_effect_it_adds():
     from hdwf.validation.effects import get as get_effect
 
     assert rung_in_words("baseline", []) == "our FE model, no effect switched on"
-    assert rung_in_words("with preload, fs_cup_torsion", []) == (
-        f"+ {get_effect('fs_cup_torsion').title} ({lit('fs_cup_torsion')})")
+    # the '+' escaped: a typst cell starting '+ ' is a numbered list item ('1. Flexspline …')
+    assert rung_in_words("with preload, fs_cup_torsion", []) == f"\\+ Flexspline cup torsion ({lit('fs_cup_torsion')})"
     assert rung_in_words("campaign model", ["preload"]) == (
-        f"the campaign's model: {get_effect('preload').title} ({lit('preload')})")
+        f"the campaign's model: {lit(get_effect('preload').title)} ({lit('preload')})")
     assert get_effect("fs_cup_torsion").title == "Flexspline cup torsion"
 
 

@@ -50,9 +50,10 @@ def rung_in_words(model: str, fixed: list[str]) -> str:
     if model == "baseline":
         return "our FE model, no effect switched on"
     if model == "campaign model":
-        return "the campaign's model: " + ", ".join(f"{get_effect(e).title} ({lit(e)})" for e in fixed)
+        return "the campaign's model: " + ", ".join(f"{lit(get_effect(e).title)} ({lit(e)})" for e in fixed)
     added = model[len("with "):].split(", ")[-1] if model.startswith("with ") else model
-    return f"+ {get_effect(added).title} ({lit(added)})"
+    # escaped: a cell starting '+ ' is a list item in typst
+    return f"{lit('+ ' + get_effect(added).title)} ({lit(added)})"
 
 
 def _detectability_rows(candidates: list[dict]) -> list[list[str]]:
