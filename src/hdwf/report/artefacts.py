@@ -1,12 +1,16 @@
 """What the report reads: the paths of each study's per-drive artefacts and of each validation
-campaign's, and the settings it quotes, as typed records. Paths only: the parts of the report
-open the files themselves."""
+campaign's, and the settings it quotes, as typed records. Paths, and one figure the summary
+and Part III both read (a campaign's measured scale); the parts of the report open the files
+themselves."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from typing import Mapping
 from pathlib import Path
+
+import numpy as np
+import pandas as pd
 
 from hdwf.drive.design import MeshSettings
 
@@ -68,6 +72,14 @@ class CampaignArtefacts:
     residuals_png: Path
     ladder_png: Path
     points: Path | None = None
+
+    def measured_rms_arcmin(self) -> float | None:
+        """The RMS of the measured values, the scale the campaign's errors are read against; None
+        where the report was given no comparison points."""
+        if self.points is None:
+            return None
+        measured = pd.read_parquet(self.points, columns=["D"])["D"].to_numpy(float)
+        return float(np.sqrt(np.nanmean(measured ** 2)))
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,6 @@ from hdwf.report.catalogue_part import catalogue_checks, catalogue_phi_text, spa
 from hdwf.report.document import UNIT_NAMES, Document, fmt, lit
 from hdwf.report.paper_part import largest_sobol_difference
 from hdwf.report.recovery_part import hidden_text, recovery_summary
-from hdwf.report.validation_part import measured_rms
 
 
 @dataclass(frozen=True)
@@ -110,7 +109,7 @@ def _over_rating(ladder: pd.DataFrame) -> str:
 def _data_scale(campaign: CampaignArtefacts, last_rmse: float) -> str:
     """The measured values' RMS and the last rung's RMSE as a share of it: a fall of the error
     says little unless the error left is small against what was measured."""
-    scale = measured_rms(campaign)
+    scale = campaign.measured_rms_arcmin()
     if scale is None:
         return ""
     share = f", the last rung {100 * last_rmse / scale:.2g} % of it" if np.isfinite(last_rmse) else ""

@@ -7,7 +7,6 @@ from __future__ import annotations
 import json
 import math
 
-import numpy as np
 import pandas as pd
 
 from hdwf import PARAMETER_COLUMNS, PARAMETERS
@@ -185,22 +184,13 @@ def _campaign_intro(doc: Document, diag: dict, study_mesh: MeshSettings | None =
              + f"Candidates tried: {lit(', '.join(sorted(r['effect'] for r in diag['ranking'])))}.")
 
 
-def measured_rms(campaign: CampaignArtefacts) -> float | None:
-    """The RMS of the campaign's measured values (arcmin), the scale its errors are read against;
-    None where the report was given no comparison points."""
-    if campaign.points is None:
-        return None
-    measured = pd.read_parquet(campaign.points, columns=["D"])["D"].to_numpy(float)
-    return float(np.sqrt(np.nanmean(measured ** 2)))
-
-
 def _where_it_fails(doc: Document, diag: dict, campaign: CampaignArtefacts, level: int) -> None:
     """The comparison error overall and per worst specimen, tests on the residuals, and the figures."""
     b = diag["baseline"]
     doc.heading("Where the model fails", level)
     rows = [["RMSE", fmt(b["rmse_arcmin"], 4)], ["bias (mean S − D)", fmt(b["bias_arcmin"], 4)],
             ["largest |E|", fmt(b["max_abs_arcmin"], 4)], ["worst specimen", lit(b["worst_specimen"])]]
-    scale = measured_rms(campaign)
+    scale = campaign.measured_rms_arcmin()
     if scale is not None:
         rows.insert(0, ["RMS of the measured values D (the scale)", fmt(scale, 4)])
     if b.get("u_val_arcmin") is not None:
