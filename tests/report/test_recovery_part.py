@@ -46,6 +46,20 @@ def test_the_chapter_holds_each_found_value_against_the_hidden_one():
     assert "the same FE model the campaign fits, so this checks the search and its calibration" in text
 
 
+def test_data_made_on_another_mesh_are_not_called_the_campaigns_own_model():
+    """The opt-in demo_finer_mesh campaign fits 5 × 3 data made at 1.25×: the chapter names both
+    meshes and says the mesh's own error is in the data, uncounted by the sd, instead of calling
+    them the same model."""
+    doc = Document("t", "s", PROVENANCE)
+    recovery_section(doc, {**_diag(FOUND), "mesh": {"elements_over_height": 5, "elements_over_thickness": 3,
+                                                    "refinement": 1.0},
+                           "data_mesh": {"elements_over_height": 5, "elements_over_thickness": 3, "refinement": 1.25}}, 3)
+    text = next(b["text"] for b in doc.blocks if b["type"] == "text")
+    assert ("made by our FE model on another mesh (5 × 3 elements a tooth, refined 1.25×) than the campaign fits "
+            "(5 × 3 elements a tooth)") in text
+    assert "same FE model the campaign fits" not in text
+
+
 def test_a_missed_effect_makes_the_summary_row_a_miss(tmp_path):
     """Cup torsion not named: the chapter says the campaign did not recover every hidden effect,
     and the summary's row is marked not met, with the hidden values as what it is held against."""

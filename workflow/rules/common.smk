@@ -106,7 +106,11 @@ def specimen_row(w):
 
 
 def plan_dict(w):
-    return dataclasses.asdict(CAMPAIGNS[w.campaign])
+    plan = dataclasses.asdict(CAMPAIGNS[w.campaign])
+    # an unset data mesh left out: a campaign that does not use it keeps its params, so its results stand
+    if not plan["data_mesh"]:
+        del plan["data_mesh"]
+    return plan
 
 
 # --- reports ------------------------------------------------------------------------------------

@@ -63,10 +63,24 @@ def recovery_section(doc: Document, diag: dict, level: int) -> None:
               f"by the search, and its final calibrated value within {rec['within_sd']:g} standard uncertainties of "
               "the hidden one (a value without a finite uncertainty is not counted).")
     order = diag.get("verdict", {}).get("found_in_order") or []
-    mesh = diag.get("mesh") or {}
-    on = (f" on the campaign's own mesh ({mesh['elements_over_height']} × {mesh['elements_over_thickness']} "
-          "elements a tooth)" if "elements_over_height" in mesh else "")
     doc.text(f"{_verdict(rec)} ({recovery_summary(rec)}); it named "
-             + (", then ".join(lit(o) for o in order) if order else "nothing") + ". "
-             f"The data were made by the same FE model the campaign fits{on}, so this checks the search and "
-             "its calibration against the noise, not the model's physics: only bench data can test that.")
+             + (", then ".join(lit(o) for o in order) if order else "nothing") + ". " + _what_it_checks(diag))
+
+
+def _mesh_text(mesh: dict) -> str:
+    refined = f", refined {mesh['refinement']:g}×" if mesh.get("refinement", 1.0) != 1.0 else ""
+    return f"{mesh['elements_over_height']} × {mesh['elements_over_thickness']} elements a tooth{refined}"
+
+
+def _what_it_checks(diag: dict) -> str:
+    """What a recovery shows: against the noise only when the data were made on the campaign's own
+    mesh; through the mesh's own error, a stand-in for model error, when made on another."""
+    mesh, data_mesh = diag.get("mesh") or {}, diag.get("data_mesh")
+    if data_mesh and "elements_over_height" in mesh:
+        return (f"The data were made by our FE model on another mesh ({_mesh_text(data_mesh)}) than the campaign "
+                f"fits ({_mesh_text(mesh)}), so the mesh's own error is in them as a stand-in for model error, "
+                "which the standard uncertainties above do not count; it still does not test the model's physics: "
+                "only bench data can.")
+    on = f" on the campaign's own mesh ({_mesh_text(mesh)})" if "elements_over_height" in mesh else ""
+    return (f"The data were made by the same FE model the campaign fits{on}, so this checks the search and "
+            "its calibration against the noise, not the model's physics: only bench data can test that.")

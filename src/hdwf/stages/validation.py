@@ -42,6 +42,7 @@ class CampaignPlan:
     steps_per_ramp: int
     about: str = ""        # what the measurements are, for the report
     hidden_effects: dict = field(default_factory=dict)   # synthetic data: {effect: {param: value}} made with
+    data_mesh: dict = field(default_factory=dict)        # synthetic data made on another mesh: its settings
 
     def table_variants(self) -> list[dict]:
         """The variants every specimen's table holds (``hdwf.validation.variants.plan_variants``)."""
@@ -105,7 +106,8 @@ def campaign_plan(name: str, camp: dict, fe: dict) -> CampaignPlan:
     return CampaignPlan(name, camp["unit"], camp["measurements"], fixed, calib, cands,
                         int(camp.get("rounds", 2)), settings,
                         int(camp.get("steps_per_ramp", fe["steps_per_ramp"])), camp.get("about", ""),
-                        {e: {p: float(v) for p, v in ps.items()} for e, ps in camp.get("hidden_effects", {}).items()})
+                        {e: {p: float(v) for p, v in ps.items()} for e, ps in camp.get("hidden_effects", {}).items()},
+                        dict(camp.get("data_mesh", {})))
 
 
 def campaign_specimens(plan: CampaignPlan) -> pd.DataFrame:
@@ -187,6 +189,8 @@ def diagnosis_stage(plan: CampaignPlan, inputs: CampaignInputs, out_json, out_po
               "about": plan.about, "mesh": plan.settings, **diagnosis.to_dict()}
     if plan.hidden_effects:
         result["hidden_effects"] = plan.hidden_effects
+        if plan.data_mesh:
+            result["data_mesh"] = plan.data_mesh
         result["recovery"] = recovery(plan.hidden_effects, result["found"],
                                       result["verdict"].get("found_in_order") or []).to_dict()
     result = json_safe({**result, "provenance": provenance})
