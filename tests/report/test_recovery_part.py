@@ -5,7 +5,6 @@ import dataclasses
 import json
 
 import pandas as pd
-import pytest
 
 from hdwf.drive.design import MeshSettings
 from hdwf.report.artefacts import CampaignArtefacts, FeSettings, ReportInputs
