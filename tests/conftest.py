@@ -1,12 +1,11 @@
-import os
-
 # One BLAS thread per test process, set before numpy loads OpenBLAS: the two workers of
 # `pytest -n 2` already fill the two cores, and OpenBLAS threads on top spin against the other
 # worker. A full-model solve measured 34 s alone, 226 s beside a second one, 35 s beside it with
 # one thread each. (Snakemake sets these for its jobs itself; the solver gains nothing from
 # more threads.)
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ.setdefault(_var, "1")
+from hdwf.common.blas import one_thread_unless_set
+
+one_thread_unless_set()
 
 import shutil  # noqa: E402
 from pathlib import Path  # noqa: E402

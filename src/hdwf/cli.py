@@ -11,19 +11,23 @@ import sys
 from contextlib import contextmanager
 from pathlib import Path
 
-from hdwf import __version__
-from hdwf.common.errors import ConfigError, InputError, SolveFailed
-from hdwf.common.io import atomic_path, write_parquet
-from hdwf.common.provenance import config_hash, provenance, tool_provenance
-from hdwf.config import SCHEMA_PATH, blame, fe_option_bounds, load_config
-from hdwf.stages.validation import campaign_plan, campaign_specimens
-from hdwf.study.paper import PAPER_TABLES, paper_measurements
-from hdwf.validation.detectability import plan_detectability
-from hdwf.validation.effects import parse_assignment, registry
-from hdwf.common.jsonsafe import json_safe
-from hdwf.validation.measurements import MeasurementError, load_measurements, schedule_problems
-from hdwf.validation.synthesis import design_ranges, format_ranges, parse_range, synth_designs, synthesize
-from hdwf.validation.variants import SolveSetup
+from hdwf.common.blas import one_thread_unless_set
+
+one_thread_unless_set()   # before numpy loads: the command's solves run like Snakemake's jobs
+
+from hdwf import __version__  # noqa: E402
+from hdwf.common.errors import ConfigError, InputError, SolveFailed  # noqa: E402
+from hdwf.common.io import atomic_path, write_parquet  # noqa: E402
+from hdwf.common.provenance import config_hash, provenance, tool_provenance  # noqa: E402
+from hdwf.config import SCHEMA_PATH, blame, fe_option_bounds, load_config  # noqa: E402
+from hdwf.stages.validation import campaign_plan, campaign_specimens  # noqa: E402
+from hdwf.study.paper import PAPER_TABLES, paper_measurements  # noqa: E402
+from hdwf.validation.detectability import plan_detectability  # noqa: E402
+from hdwf.validation.effects import parse_assignment, registry  # noqa: E402
+from hdwf.common.jsonsafe import json_safe  # noqa: E402
+from hdwf.validation.measurements import MeasurementError, load_measurements, schedule_problems  # noqa: E402
+from hdwf.validation.synthesis import design_ranges, format_ranges, parse_range, synth_designs, synthesize  # noqa: E402
+from hdwf.validation.variants import SolveSetup  # noqa: E402
 
 
 def _count(n: int, noun: str) -> str:

@@ -5,7 +5,13 @@ import logging
 import os
 from pathlib import Path
 
-from hdwf.common.provenance import provenance
+from hdwf.common.blas import one_thread_unless_set
+
+# Snakemake gives a job the rule's one BLAS thread; a script run by hand would get one per core,
+# which spin against any other work. Set before numpy loads (the scripts import this module first).
+one_thread_unless_set()
+
+from hdwf.common.provenance import provenance  # noqa: E402
 
 PROJECT_ROOT = Path(__file__).resolve().parents[2]
 

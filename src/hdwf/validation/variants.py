@@ -39,6 +39,7 @@ import pyarrow as pa
 from tqdm import tqdm
 
 from hdwf import PARAMETER_COLUMNS
+from hdwf.common.blas import BLAS_VARS
 from hdwf.common.io import arrow_table
 from hdwf.drive.design import MeshSettings, geometry_of
 from hdwf.drive.geometry import ARCMIN, DriveGeometry
@@ -58,7 +59,6 @@ TABLE_COLUMNS = ["specimen_id", "variant", "step", "torque_Nm", "twist_arcmin", 
 # same for every step of a variant), to hold a found effect against the bearing's rating;
 # max_penetration_redetected_um: the solver's check from scratch at +-T, as the studies' rows keep it
 # the thread counts of the BLAS libraries numpy and scipy may be linked against
-_BLAS_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 
 @dataclass(frozen=True)
@@ -234,8 +234,8 @@ def _specimen_job(task: tuple[SolveSetup, dict, list[dict]]) -> pa.Table:
 @contextmanager
 def _one_blas_thread():
     """BLAS limited to one thread in the processes started inside the block."""
-    saved = {k: os.environ.get(k) for k in _BLAS_VARS}
-    os.environ.update({k: "1" for k in _BLAS_VARS})
+    saved = {k: os.environ.get(k) for k in BLAS_VARS}
+    os.environ.update({k: "1" for k in BLAS_VARS})
     try:
         yield
     finally:
