@@ -58,7 +58,6 @@ TABLE_COLUMNS = ["specimen_id", "variant", "step", "torque_Nm", "twist_arcmin", 
 # ball_pressure_max_MPa: the most loaded wave-generator ball's raceway pressure at the mount (the
 # same for every step of a variant), to hold a found effect against the bearing's rating;
 # max_penetration_redetected_um: the solver's check from scratch at +-T, as the studies' rows keep it
-# the thread counts of the BLAS libraries numpy and scipy may be linked against
 
 
 @dataclass(frozen=True)
