@@ -2,7 +2,7 @@
 
 The solver's dense work is small blocks (a few hundred pairs), where OpenBLAS threads cost more
 than they give, and beside any other work on the machine spin against it (a study solve by hand:
-6.8 s with one thread, 10.0 s with two; docs/architecture.md). Snakemake gives each job
+8.0 s with one thread, 12.0 s with two; ``benchmarks/bench_blas_threads.py``). Snakemake gives each job
 the rule's threads (one); the entry points that run outside it (the ``hdwf`` command, a rule
 script run by hand, the benchmarks, the tests) call ``one_thread_unless_set`` before numpy
 loads, since OpenBLAS reads these variables only then.
