@@ -50,7 +50,7 @@ def main():
     with tempfile.TemporaryDirectory(prefix="hdwf-bench-") as tmp:
         project = copy_workflow(Path(tmp))
         subprocess.run([SNAKEMAKE, "results/fe/hd42/designs.parquet", "--cores", "1", "--quiet"],
-                       cwd=project, check=True)
+                       cwd=project, check=True, capture_output=True)
         times: dict[int, list[tuple[float, float]]] = {t: [] for t in counts}
         for _ in range(args.repeats):
             for t in counts:
