@@ -84,3 +84,44 @@ def test_a_mounted_preload_on_a_layer_holds_each_pair_at_its_share_of_the_overla
     # some pairs sit at the edge of a contact, where the share is less than half their edges
     lumped = rows.compliance
     assert np.sum(s[loaded] > 1.05 * lumped[loaded]) > 0
+
+
+def test_a_layer_is_integrated_along_the_fs_outline_alone():
+    """With a flank layer the tooth rows are the FS pass alone (each overlap counted once, on the
+    outline the layer's integral runs along); without one the CS tip-land pass is there too, so
+    that a CS tip corner cannot sink into an FS flank between two FS nodes."""
+    import dataclasses
+
+    from hdwf.drive.geometry import drive_geometry
+    from hdwf.drive.mesh import build_mesh
+    from hdwf.fe import LostMotionModel
+    from hdwf.fe.contact_rows import tooth_rows
+
+    g = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.0, 0.0, interference_m=0.3, tip_relief=1.1, tip_round_m=0.1)
+    model = LostMotionModel(g, build_mesh(g, elements_over_height=5, elements_over_thickness=3, symmetry="half"),
+                            zone_deg=90.0)
+    u = np.zeros(model.nwatch)
+    bare = tooth_rows(model.structure, g, u, np.inf)
+    layered = tooth_rows(model.structure, dataclasses.replace(g, flank_layer_um_per_MPa=3.0), u, np.inf)
+    assert bare.slave_nodes[1].size > 0
+    assert layered.slave_nodes[1].size == 0
+    assert np.array_equal(layered.slave_nodes[0], bare.slave_nodes[0])
+    assert layered.G.shape[0] == layered.slave_nodes[0].size == layered.compliance.size
+
+
+def test_a_layer_is_solved_on_rounded_tips_and_refuses_sharp_ones():
+    """The layer's changes shape the outline: the tip corners rounded by 0.1 m
+    (``LAYER_TIP_ROUND_M``); a solve given a mesh of sharp tips with a layer refuses, naming the
+    field, as it refuses a preload on teeth that were not thickened."""
+    from hdwf.drive.geometry import drive_geometry
+    from hdwf.drive.mesh import build_mesh
+    from hdwf.fe import ModelChanges, solve_lost_motion
+    from hdwf.fe.changes import LAYER_TIP_ROUND_M
+
+    changes = ModelChanges(flank_interference_m=0.3, flank_layer_m=3800.0)
+    assert LAYER_TIP_ROUND_M == 0.1
+    assert changes.geometry_part() == {"interference_m": 0.3, "tip_relief": 1.1, "tip_round_m": 0.1}
+    assert ModelChanges(flank_interference_m=0.3).geometry_part()["tip_round_m"] == 0.0
+    sharp = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.0, 0.0, interference_m=0.3, tip_relief=1.1)
+    with pytest.raises(ValueError, match="tip_round_m"):
+        solve_lost_motion(sharp, build_mesh(sharp, 5, 3, symmetry="half"), 1, changes=changes)
