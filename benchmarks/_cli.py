@@ -18,16 +18,14 @@ def add_shape_arguments(ap: argparse.ArgumentParser) -> None:
                     help="addendum / tooth height of FS and CS (default the unit's 0.45)")
     ap.add_argument("--offsets", choices=("normal", "radial"), default="normal",
                     help="DriveGeometry.offset_direction: r_FS, r_CS as normal flank offsets or rack shifts")
-    ap.add_argument("--tip-round", type=float, default=None,
-                    help="DriveGeometry.tip_round_m: radius of the FS and CS tip corners' round, units of m "
-                         "(default: as the model's effects ask, 0.1 with a flank layer, else sharp)")
+    ap.add_argument("--tip-round", type=float, default=0.0,
+                    help="DriveGeometry.tip_round_m: radius of the FS and CS tip corners' round, units of m")
 
 
 def shape_of(args: argparse.Namespace) -> dict:
-    """The ``drive_geometry`` keywords the options ask for (``tip_round_m`` only if given)."""
-    shape = {"deflection_coeff": args.deflection, "addendum_frac": args.addendum_frac,
-             "offset_direction": args.offsets}
-    return shape if args.tip_round is None else {**shape, "tip_round_m": args.tip_round}
+    """The ``drive_geometry`` keywords the options ask for."""
+    return {"deflection_coeff": args.deflection, "addendum_frac": args.addendum_frac,
+            "offset_direction": args.offsets, "tip_round_m": args.tip_round}
 
 
 def check_names(names) -> None:

@@ -6,8 +6,7 @@ over the tooth height x thickness (default 10x6, the studies'; half model, 5 ste
 solves it with ``--effects`` switched on (default: the ``fe.effects`` of ``config.yaml``) and
 appends one row per mesh to ``--out`` (CSV: design, mesh, refinement, effects, zone, nodes, status,
 Φ, φ+, φ−, teeth in contact, overlap left outside the zones, seconds).  ``--tip-round 0.1`` rounds
-the FS and CS tip corners with a radius of 0.1 m (``drive_geometry``'s ``tip_round_m``; by default as
-the effects ask: 0.1 m with a flank layer, ``ModelChanges.geometry_part``, else sharp).  ``--mesh 20x6`` refines the teeth (their size is the finer
+the FS and CS tip corners with a radius of 0.1 m (``drive_geometry``'s ``tip_round_m``).  ``--mesh 20x6`` refines the teeth (their size is the finer
 of height / 20 and thickness / 6) and what grades from them (the FS rim, the CS rim where four
 tooth sizes decide), not the bearing rings.  ``--zone 45`` solves the contacts of the teeth within
 45 deg of a major axis only (default: every tooth, as a preload needs) and records the overlap
@@ -46,7 +45,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def refine(unit: str, designs: Path, design: str, refinements: list[float], effects: dict, out: Path,
-           per_tooth: tuple[int, int] = (10, 6), zone_deg: float | None = None, tip_round_m: float | None = None,
+           per_tooth: tuple[int, int] = (10, 6), zone_deg: float | None = None, tip_round_m: float = 0.0,
            flank_refinement: float = 1.0, tip_relief: float | None = None) -> None:
     params = design_parameters(designs, design)
     changes = model_changes(effects)
@@ -55,9 +54,7 @@ def refine(unit: str, designs: Path, design: str, refinements: list[float], effe
         # the outline carries the allowance and this relief; the changes then must not ask for theirs
         shape["tip_relief"] = tip_relief
         changes = replace(changes, flank_interference_m=0.0)
-    if tip_round_m is not None:     # else as the effects ask (rounded with a flank layer)
-        shape["tip_round_m"] = tip_round_m
-    geom = geometry_of(unit, params, **shape)
+    geom = geometry_of(unit, params, **shape, tip_round_m=tip_round_m)
     for ref in refinements:
         t0 = time.perf_counter()
         mesh = build_mesh(geom, *per_tooth, ref, symmetry="half", flank_refinement=flank_refinement)
@@ -89,8 +86,7 @@ if __name__ == "__main__":
     ap.add_argument("--out", type=Path, default=Path("refine.csv"))
     ap.add_argument("--mesh", default="10x6", help="elements over the tooth height x thickness")
     ap.add_argument("--zone", type=float, default=None, help="half width (deg) of the solved tooth zones")
-    ap.add_argument("--tip-round", type=float, default=None,
-                    help="radius of the tip corners' round, units of m (default: as the effects ask)")
+    ap.add_argument("--tip-round", type=float, default=0.0, help="radius of the tip corners' round, units of m")
     ap.add_argument("--tip-relief", type=float, default=None,
                     help="multiple of the derived tip relief for the preloaded outline (default: the preload's)")
     ap.add_argument("--flank-refinement", type=float, default=1.0,

@@ -22,10 +22,7 @@ cam (``DriveGeometry.deflection_coeff``; docs/fe-alternatives.md, "A deeper cam"
 ``--offsets radial`` reads r_FS, r_CS as rack shifts (``DriveGeometry.offset_direction``);
 ``--tip-round 0.1`` rounds the tip corners (``DriveGeometry.tip_round_m``).
 ``--flank-layer 1167,2333`` solves each interference with a compliant flank layer of each
-thickness (modules; effect ``flank_layer``, docs/fe-model.md, "A compliant flank layer"); with a
-layer the tip corners are rounded as the layer asks (``ModelChanges.geometry_part``) unless
-``--tip-round`` says otherwise.  ``--flank-refinement 1.5`` divides every flank into 1.5 times
-its segments (``build_mesh``'s ``flank_refinement``; the studies' ``fe.flank_refinement``).
+thickness (modules; effect ``flank_layer``, docs/fe-model.md, "A compliant flank layer").
 """
 
 from __future__ import annotations
@@ -63,18 +60,15 @@ def _sets(text: str) -> list[int]:
 
 def solve_all(unit: str, sets: list[int], interferences: list[float], zone90: bool, out: Path,
               tip_relief: float = 0.0, zone: float | None = None, mesh_size: tuple[int, int] = (5, 3),
-              shape: dict | None = None, layers: tuple[float, ...] = (0.0,), flank_refinement: float = 1.0):
-    shape = dict(shape or {})     # deflection_coeff / addendum_frac / offset_direction for drive_geometry
-    if any(lam > 0 for lam in layers):     # the rounds a layer is solved with, unless asked otherwise
-        shape.setdefault("tip_round_m", ModelChanges(flank_layer_m=max(layers)).geometry_part()["tip_round_m"])
+              shape: dict | None = None, layers: tuple[float, ...] = (0.0,)):
+    shape = shape or {}     # deflection_coeff / addendum_frac / offset_direction for drive_geometry
     table = pd.read_csv(ROOT / "data" / "paper" / TABLES[unit]).set_index("set")
     for s in sets:
         row = table.loc[s]
         g0 = drive_geometry(unit, *(row[c] for c in COLUMNS), tip_relief=tip_relief, **shape)
         t0 = time.perf_counter()
         eh, et = mesh_size
-        mesh = build_mesh(g0, elements_over_height=eh, elements_over_thickness=et, symmetry="half",
-                          flank_refinement=flank_refinement)
+        mesh = build_mesh(g0, elements_over_height=eh, elements_over_thickness=et, symmetry="half")
         mesh_s = time.perf_counter() - t0
         runs = [(i, zone, lam) for i in interferences for lam in layers] + ([(0.0, 90.0, 0.0)] if zone90 else [])
         for im, zone_deg, lam in runs:
@@ -82,14 +76,13 @@ def solve_all(unit: str, sets: list[int], interferences: list[float], zone90: bo
             g = drive_geometry(unit, *(row[c] for c in COLUMNS), interference_m=im,
                                tip_relief=tip_relief, **shape)
             m = mesh if im == 0 else build_mesh(g, elements_over_height=eh, elements_over_thickness=et,
-                                                symmetry="half", flank_refinement=flank_refinement)
+                                                symmetry="half")
             r = solve_lost_motion(g, m, steps_per_ramp=5, zone_deg=zone_deg,
                                   changes=ModelChanges(flank_layer_m=lam))
             rec = {"unit": unit, "set": s, "interference_m": im, "flank_layer_m": lam, "tip_relief": tip_relief,
                    "deflection_coeff": g.deflection_coeff, "addendum_frac": round(g.addendum / (
                        g.r_fs_tip - g.r_fs_root), 6), "offset_direction": g.offset_direction,
-                   "tip_round_m": g.tip_round_m, "mesh": f"{eh}x{et}" + (
-                       f"/{flank_refinement:g}" if flank_refinement != 1 else ""),
+                   "tip_round_m": g.tip_round_m, "mesh": f"{eh}x{et}",
                    "zone_deg": zone_deg if zone_deg else (90.0 if g.preloaded else 35.0),
                    "status": r.status, "overlap_outside_zones_um": r.overlap_outside_zones_um,
                    "reason": r.reason[:200], "phi": r.lost_motion_arcmin,
@@ -169,12 +162,10 @@ if __name__ == "__main__":
     add_shape_arguments(ap)
     ap.add_argument("--flank-layer", default="0",
                     help="flank layer thicknesses (modules, comma separated; 0 = none)")
-    ap.add_argument("--flank-refinement", type=float, default=1.0,
-                    help="multiplies the segments along every flank (the studies' fe.flank_refinement)")
     ap.add_argument("--summary-only", action="store_true")
     a = ap.parse_args()
     if not a.summary_only:
         solve_all(a.unit, _sets(a.sets), [float(x) for x in a.interference.split(",")], a.zone90,
                   a.out, a.tip_relief, a.zone, tuple(int(n) for n in a.mesh.split("x")),
-                  shape_of(a), tuple(float(x) for x in a.flank_layer.split(",")), a.flank_refinement)
+                  shape_of(a), tuple(float(x) for x in a.flank_layer.split(",")))
     summary(a.out)

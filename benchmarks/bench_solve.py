@@ -5,9 +5,8 @@ Options: a positional refinement (default 1.0), ``--symmetry full|half`` (defaul
 the half model uses the drive's 180 deg point symmetry), ``--unit hd42|hd120`` (HD 120
 Table 5 set 8), ``--repeats N``, ``--preload DELTA`` (a preloaded engagement alone,
 ``interference_m`` = DELTA with its tip relief, every tooth watched) and ``--studies-model``
-(the effects of ``config.yaml``'s ``fe.effects`` and its ``fe.flank_refinement``, the model and
-mesh of the ``fe`` and ``fe_at_paper`` studies); ``--tip-round 0.1`` rounds the tip corners
-(``DriveGeometry.tip_round_m``; by default as the effects ask);
+(the effects of ``config.yaml``'s ``fe.effects``, the model of the ``fe`` and ``fe_at_paper`` studies);
+``--tip-round 0.1`` rounds the tip corners (``DriveGeometry.tip_round_m``);
 ``--plain-columns`` back-substitutes the FS's and CS's columns node set by node set, not turned
 from one tooth period's (``hdwf.fe.ring_columns``), for comparison.
 Prints mesh time, solve_s, factorize_s (one factorisation of every body's stiffness),
@@ -41,22 +40,19 @@ DESIGNS = {
 
 
 def main(repeats: int = 3, refinement: float = 1.0, symmetry: str = "full",
-         unit: str = "hd42", preload: float = 0.0, studies_model: bool = False, tip_round_m: float | None = None) -> None:
+         unit: str = "hd42", preload: float = 0.0, studies_model: bool = False, tip_round_m: float = 0.0) -> None:
     args, label = DESIGNS[unit]
-    flank_refinement = 1.0
     if studies_model:
-        fe = load_config(ROOT / "config.yaml")["fe"]
-        effects, flank_refinement = fe["effects"], fe.get("flank_refinement", 1.0)
-        label += f", the studies' model {effects}, flank refinement {flank_refinement:g}"
+        effects = load_config(ROOT / "config.yaml")["fe"]["effects"]
+        label += f", the studies' model {effects}"
     else:
         effects = {"preload": {"interference_m": preload}} if preload > 0 else {}
         label += f", preload {preload:g} m" if preload > 0 else ""
     changes = model_changes(effects)
-    shape = changes.geometry_part() | ({} if tip_round_m is None else {"tip_round_m": tip_round_m})
-    g = drive_geometry(*args, **shape)
-    label += f", tip corners rounded {g.tip_round_m:g} m" if g.tip_round_m else ""
+    g = drive_geometry(*args, **changes.geometry_part(), tip_round_m=tip_round_m)
+    label += f", tip corners rounded {tip_round_m:g} m" if tip_round_m else ""
     t0 = time.perf_counter()
-    mesh = build_mesh(g, refinement=refinement, symmetry=symmetry, flank_refinement=flank_refinement)
+    mesh = build_mesh(g, refinement=refinement, symmetry=symmetry)
     mesh_s = time.perf_counter() - t0
     runs = []
     for _ in range(repeats):
@@ -91,9 +87,8 @@ if __name__ == "__main__":
     model = ap.add_mutually_exclusive_group()
     model.add_argument("--preload", type=float, default=0.0, help="interference_m of the preload (0: bare)")
     model.add_argument("--studies-model", action="store_true", help="config.yaml's fe.effects")
-    ap.add_argument("--tip-round", type=float, default=None,
-                    help="DriveGeometry.tip_round_m: radius of the tip corners' round, units of m "
-                         "(default: as the effects ask)")
+    ap.add_argument("--tip-round", type=float, default=0.0,
+                    help="DriveGeometry.tip_round_m: radius of the tip corners' round, units of m")
     ap.add_argument("--plain-columns", action="store_true",
                     help="no columns turned from one period (hdwf.fe.ring_columns), for comparison")
     a = ap.parse_args()

@@ -442,21 +442,17 @@ def test_flank_layer_stiffness_is_the_flank_area_over_c():
 @pytest.mark.slow
 def test_flank_layer_softens_a_preloaded_drive_and_vanishes_with_c():
     """A preloaded drive (0.157 m) with a flank layer has more lost motion (the penetration check
-    allows the layer's approach s p), a vanishing layer gives the drive without one (to what the
-    FS pass alone resolves), and the
+    allows the layer's approach s p), a vanishing layer gives the drive without one, and the
     effect's parameter (``ModelChanges.flank_layer_m``) gives the same solve.  (At the edge of a
     contact the overlap integrated on a layer grows as sqrt(c) — the force of a corner sunk by
     d into it goes as d^2 — so 'vanishing' is 1e-9 um/MPa: 1e-6 leaves 0.02 um there.)"""
     import dataclasses
-    g = drive_geometry(*NOMINAL, interference_m=0.157, tip_relief=1.1, tip_round_m=0.1)   # a layer's rounds
+    g = drive_geometry(*NOMINAL, interference_m=0.157, tip_relief=1.1)
     mesh = build_mesh(g, **COARSE, symmetry="half")
     phi = {c: solve_lost_motion(dataclasses.replace(g, flank_layer_um_per_MPa=c), mesh, steps_per_ramp=1)
            for c in (0.0, 1e-9, 0.3)}
     assert all(r.status == "ok" for r in phi.values()), [r.reason for r in phi.values()]
-    # a layer is solved on the FS pass alone, the bare contact with the CS tips' pass too: a vanishing
-    # layer is rigid contact measured from the FS side, which on this coarse mesh (5 segments a
-    # flank) lets a CS tip round sink between two FS nodes (measured 0.01583 against 0.01566 arcmin)
-    assert phi[1e-9].lost_motion_arcmin == pytest.approx(phi[0.0].lost_motion_arcmin, rel=0.02)
+    assert phi[1e-9].lost_motion_arcmin == pytest.approx(phi[0.0].lost_motion_arcmin, abs=1e-4)
     assert phi[0.3].lost_motion_arcmin > 2 * phi[0.0].lost_motion_arcmin
     from hdwf.fe.changes import ModelChanges   # the effect's way in: the same layer in modules
     via = solve_lost_motion(g, mesh, steps_per_ramp=1, changes=ModelChanges(flank_layer_m=0.3e-3 * g.E / g.module))

@@ -273,8 +273,8 @@ def test_catalogue_section_says_when_the_papers_drives_leave_the_size_law_and_ou
 
 @pytest.mark.parametrize("flank_refinement, said", [(1.0, None), (2.5, "(25 a flank, `fe.flank_refinement`)")])
 def test_the_fe_section_names_a_finer_flank_division(flank_refinement, said):
-    """A report whose flanks are divided 2.5 times finer than the paper's rule (the default) must say
-    so, or its convergence table reads as the paper's 10 x 6 rule; at 1 the text names no division."""
+    """A report of the fine_flanks overlay must say its flanks were divided 2.5 times finer, or its
+    convergence table reads as the paper's 10 x 6 rule; the default's text stays as it was."""
     from hdwf.drive.design import MeshSettings
     from hdwf.report.artefacts import FeSettings
     from hdwf.report.fe_part import fe_model_section

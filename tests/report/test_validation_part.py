@@ -20,7 +20,7 @@ def test_ladder_is_held_against_the_bearing_rating():
     assert "Every rung stays within it" in _bearing_sentence(lad.iloc[:1])
     assert _bearing_sentence(lad.drop(columns=["specimens_checked"])) == ""
     # a preload over the rating without the layer, beside the studies' larger one on their layer
-    studies = {"preload": {"interference_m": 0.3}, "flank_layer": {"thickness_m": 3800.0}}
+    studies = {"preload": {"interference_m": 0.3}, "flank_layer": {"thickness_m": 3900.0}}
     lad["effects"] = ["{}", '{"preload": {"interference_m": 0.186}}']
     assert _bearing_sentence(lad, studies).endswith(
         "The FE studies of Part II carry a larger allowance (0.3 modules) within the rating because their flank layer "

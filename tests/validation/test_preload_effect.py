@@ -29,7 +29,7 @@ def test_a_reshaping_change_needs_its_geometry():
     """The solve cannot thicken the teeth of a mesh it is given: it refuses, naming the field."""
     g = geometry_of("hd42", SPECIMEN)
     changes = model_changes({"preload": {"interference_m": 0.1}})
-    assert changes.geometry_part() == {"interference_m": 0.1, "tip_relief": PRELOAD_TIP_RELIEF, "tip_round_m": 0.0}
+    assert changes.geometry_part() == {"interference_m": 0.1, "tip_relief": PRELOAD_TIP_RELIEF}
     with pytest.raises(ValueError, match="interference_m"):
         solve_lost_motion(g, MeshSettings.from_mapping(MESH).mesh(g), 1, changes=changes)
 
@@ -63,4 +63,4 @@ def test_preload_variants_equal_their_own_solves_and_take_the_clearance_up():
     base, mid, locked = phi["baseline"], phi["preload:interference_m=0.05"], phi["preload:interference_m=0.1"]
     assert base == pytest.approx(3.4, rel=0.15)
     assert base > mid > locked and locked < 0.1 * base
-    assert ModelChanges().geometry_part() == {"interference_m": 0.0, "tip_relief": 0.0, "tip_round_m": 0.0}
+    assert ModelChanges().geometry_part() == {"interference_m": 0.0, "tip_relief": 0.0}

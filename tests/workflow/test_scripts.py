@@ -89,17 +89,16 @@ print(json.dumps([solve, refined]))
 
 
 def test_the_flank_division_of_the_config_reaches_every_study_mesh(tmp_path):
-    """`fe.flank_refinement` (an overlay setting 1.5 instead of the default 2.5) must reach the
-    study's solves and its convergence runs alike: were it lost on either, the 1.25x check would
-    compare two different flank divisions and call it a mesh's convergence."""
+    """`fe.flank_refinement` (workflow/overlays/fine_flanks.yaml) must reach the study's solves
+    and its convergence runs alike: were it lost on either, the 1.25x check would compare two
+    different flank divisions (25 against 12 segments) and call it a mesh's convergence."""
     import json
 
     copy_workflow(tmp_path)
-    (tmp_path / "overlay.yaml").write_text("fe:\n  flank_refinement: 1.5\n")
-    run = subprocess.run([sys.executable, "-c", _MESH_PARAMS, str(tmp_path), "overlay.yaml"],
+    run = subprocess.run([sys.executable, "-c", _MESH_PARAMS, str(tmp_path), "workflow/overlays/fine_flanks.yaml"],
                          capture_output=True, text=True, timeout=120)
     assert run.returncode == 0, run.stderr[-3000:]
     solve, refined = json.loads(run.stdout.strip().splitlines()[-1])
     assert solve == {"elements_over_height": 10, "elements_over_thickness": 6, "refinement": 1.0,
-                     "symmetry": "half", "flank_refinement": 1.5}
+                     "symmetry": "half", "flank_refinement": 2.5}
     assert refined == {**solve, "refinement": 1.25}

@@ -13,10 +13,6 @@ from dataclasses import dataclass, replace
 
 from hdwf.drive.relief import PRELOAD_TIP_RELIEF
 
-# The tip corners' round (units of m) a flank layer is solved with: a tip crossing a flank in the
-# exit zone then presses a curve of several nodes into it, not a corner between two
-LAYER_TIP_ROUND_M = 0.1
-
 
 @dataclass(frozen=True)
 class ModelChanges:
@@ -52,10 +48,7 @@ class ModelChanges:
       this many modules thick: c = flank_layer_m m / E (mm of approach per MPa of contact
       pressure), in series with every tooth pair over its share of the flank (``contact_rows``).
       It stands for compliance under each tooth that a plane section lacks (the 3D cup and
-      face); the solve carries it (``DriveGeometry.flank_layer_um_per_MPa``).  Its overlap is
-      integrated along the FS outline alone (one contact pass, each overlap counted once), and the
-      FS and CS tip corners are rounded by ``LAYER_TIP_ROUND_M`` (``geometry_part``): on sharp
-      corners the integral hangs on where a node or two fall (docs/fe-model.md, "Mesh convergence").
+      face); the mesh is unchanged, the solve carries it (``DriveGeometry.flank_layer_um_per_MPa``).
     * ``coning_slope``: the FS cup's coning c = b / z_0: the wave generator's push grows as
       w0 (1 + c zeta) across the face width (zeta = 0 at the diaphragm end), solved as
       ``coning_slices`` sections in parallel on one twist (``hdwf.fe.coning``; 0 = the uniform
@@ -78,11 +71,9 @@ class ModelChanges:
         return 1e3 * self.flank_layer_m * module_mm / E_MPa
 
     def geometry_part(self) -> dict[str, float]:
-        """The ``drive_geometry`` arguments these changes need (``interference_m``, ``tip_relief``,
-        ``tip_round_m``)."""
+        """The ``drive_geometry`` arguments these changes need (``interference_m``, ``tip_relief``)."""
         relieved = PRELOAD_TIP_RELIEF if self.flank_interference_m > 0 else 0.0
-        rounded = LAYER_TIP_ROUND_M if self.flank_layer_m > 0 else 0.0
-        return {"interference_m": self.flank_interference_m, "tip_relief": relieved, "tip_round_m": rounded}
+        return {"interference_m": self.flank_interference_m, "tip_relief": relieved}
 
     def fe_part(self) -> "ModelChanges":
         """The changes that need a new contact solve: all but the series elements."""

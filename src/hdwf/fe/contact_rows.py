@@ -25,8 +25,7 @@ Contacts (unilateral; the flanks may carry friction, ``friction``), one block of
   pair also has a slip row (tangent to the master segment) for flank friction.  With a
   flank layer every pair has a compliance in series: its node's share of the layer's
   pressure (overlap / c) integrated along the slave outline (``LayerEdges``; the share
-  depends on the gaps, so the solver iterates it as it does the balls' Hertz secants),
-  and the FS pass alone is solved, so each overlap is counted once.
+  depends on the gaps, so the solver iterates it as it does the balls' Hertz secants).
 
 Half model: contacts cover angles [0, pi) only, each standing for itself and its image:
 balls 0 .. n/2-1 (ball 0 on the cut), fit bins over [0, pi), cam rows and tooth slave nodes
@@ -343,9 +342,7 @@ def tooth_rows(structure: Structure, geom: DriveGeometry, u_watch: np.ndarray, c
 
     Two passes: every FS tooth-boundary node against the CS tooth segments, and the CS
     tip-land nodes (tip corners included) against the FS tooth segments: one pass alone
-    would let a CS tip corner sink into an FS flank between two FS nodes.  With a flank layer
-    the first pass alone: the layer's overlap is integrated along the FS outline, and a
-    tip corner sinking in is the layer's own compliance (its tips are rounded).  A node beyond
+    would let a CS tip corner sink into an FS flank between two FS nodes.  A node beyond
     the end of its closest segment gets its distance to the corner as its gap
     (``closest_segments``).
 
@@ -376,11 +373,6 @@ def tooth_rows(structure: Structure, geom: DriveGeometry, u_watch: np.ndarray, c
         # a rounded tip's nodes lie within about 0.6 of its radius of the tip circle
         tip_band = geom.r_cs_tip + max(CS_TIP_BAND * (geom.r_cs_root - geom.r_cs_tip), geom.tip_round)
         sn_cs = cs.independent(cn[r_cn <= tip_band])
-        if geom.flank_layer_um_per_MPa > 0:
-            # a layer's pressure is integrated along the FS outline, which meets every overlap;
-            # the CS tip pass would count the overlap at a CS tip corner again, over a length its
-            # edges set (docs/fe-model.md, "Mesh convergence")
-            sn_cs = sn_cs[:0]
     else:
         sn_fs, sn_cs = nodes
     fs_pass = _node_to_segment(fs, sn_fs, cs, "cs_teeth", u_watch, cand_gap)

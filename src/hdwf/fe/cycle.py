@@ -286,13 +286,11 @@ def _zone(geom: DriveGeometry, zone_deg: float | None) -> float:
 def _check_geometry(geom: DriveGeometry, changes: ModelChanges) -> None:
     """Changes that reshape the section (``ModelChanges.geometry_part``) must come with a geometry
     made with them: the solve cannot thicken the teeth of a mesh it is given."""
-    need = changes.geometry_part()
-    shaped = (("interference_m", "tip_relief") if changes.flank_interference_m > 0 else ()) \
-        + (("tip_round_m",) if changes.flank_layer_m > 0 else ())
-    have = {k: getattr(geom, k) for k in need}
-    if any(have[k] != need[k] for k in shaped):
-        raise ValueError(f"changes with {need} need a geometry made with them (ModelChanges.geometry_part); "
-                         f"this one has {have}")
+    if changes.flank_interference_m > 0:
+        need = changes.geometry_part()
+        if (need["interference_m"], need["tip_relief"]) != (geom.interference_m, geom.tip_relief):
+            raise ValueError(f"changes with {need} need a geometry made with them (ModelChanges.geometry_part); "
+                             f"this one has interference_m={geom.interference_m}, tip_relief={geom.tip_relief}")
 
 
 def solve_lost_motion(geom: DriveGeometry, mesh: DriveMesh, steps_per_ramp: int = 5,
