@@ -84,3 +84,34 @@ def test_a_mounted_preload_on_a_layer_holds_each_pair_at_its_share_of_the_overla
     # some pairs sit at the edge of a contact, where the share is less than half their edges
     lumped = rows.compliance
     assert np.sum(s[loaded] > 1.05 * lumped[loaded]) > 0
+
+
+def test_a_layer_on_the_fs_pass_alone_drops_the_cs_tip_pass_only():
+    """``flank_layer_fs_pass_only``: the tooth rows are the FS pass alone, its rows those of the two
+    passes' FS pass (each overlap counted once, along the outline the layer's integral runs on);
+    without the option, or without a layer, the CS tip-land pass is there too, so that a CS tip
+    corner cannot sink into an FS flank between two FS nodes."""
+    import dataclasses
+
+    from hdwf.drive.geometry import drive_geometry
+    from hdwf.drive.mesh import build_mesh
+    from hdwf.fe import LostMotionModel, ModelChanges
+    from hdwf.fe.contact_rows import tooth_rows
+    from hdwf.fe.model import with_flank_layer
+
+    g = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.0, 0.0, interference_m=0.3, tip_relief=1.1, tip_round_m=0.1)
+    model = LostMotionModel(g, build_mesh(g, elements_over_height=5, elements_over_thickness=3, symmetry="half"),
+                            zone_deg=90.0)
+    u = np.zeros(model.nwatch)
+    both = tooth_rows(model.structure, with_flank_layer(g, ModelChanges(flank_layer_m=3800.0)), u, np.inf)
+    one = with_flank_layer(g, ModelChanges(flank_layer_m=3800.0, flank_layer_fs_pass_only=True))
+    assert one.flank_layer_fs_pass_only and one.flank_layer_um_per_MPa > 0
+    fs_only = tooth_rows(model.structure, one, u, np.inf)
+    no_layer = tooth_rows(model.structure, dataclasses.replace(g, flank_layer_fs_pass_only=True), u, np.inf)
+    assert both.slave_nodes[1].size > 0 and no_layer.slave_nodes[1].size == both.slave_nodes[1].size
+    assert fs_only.slave_nodes[1].size == 0
+    assert np.array_equal(fs_only.slave_nodes[0], both.slave_nodes[0])
+    n_fs = fs_only.slave_nodes[0].size
+    assert fs_only.G.shape[0] == n_fs == fs_only.compliance.size
+    assert abs(fs_only.G - both.G[:n_fs]).max() == 0.0
+    np.testing.assert_array_equal(fs_only.compliance, both.compliance[:n_fs])

@@ -289,6 +289,24 @@ def test_the_fe_section_names_a_finer_flank_division(flank_refinement, said):
         assert "every flank divided into 2.5 times as many segments " + said in settings_text
 
 
+def test_the_fe_section_names_the_converged_contact():
+    """A report of the converged_contact overlay must say its tips were rounded and its layer solved
+    on one pass: its Φ and convergence table belong to that contact, not the default's."""
+    from hdwf.drive.design import MeshSettings
+    from hdwf.report.artefacts import FeSettings
+    from hdwf.report.fe_part import fe_model_section
+
+    texts = []
+    for tip, one_pass in ((0.0, False), (0.1, True)):
+        doc = Document("t", "s", PROVENANCE)
+        fe_model_section(doc, (), {}, FeSettings(MeshSettings(flank_refinement=2.5), 5, tip_round_m=tip,
+                                                 flank_layer_fs_pass_only=one_pass))
+        texts.append(next(b["text"] for b in doc.blocks if b.get("text", "").startswith("Settings:")))
+    assert "rounded" not in texts[0] and "one contact pass" not in texts[0]
+    assert "the tip corners rounded 0.1 m (`fe.tip_round_m`)" in texts[1]
+    assert "the flank layer integrated along the FS outline alone (one contact pass" in texts[1]
+
+
 def test_the_constants_table_sets_both_drives_side_by_side():
     """One row a quantity (the paper's 240 teeth on both, the module 0.18 against 0.514 mm), not each
     source text twice; E and ν, common to both, in both columns."""

@@ -102,3 +102,39 @@ def test_the_flank_division_of_the_config_reaches_every_study_mesh(tmp_path):
     assert solve == {"elements_over_height": 10, "elements_over_thickness": 6, "refinement": 1.0,
                      "symmetry": "half", "flank_refinement": 2.5}
     assert refined == {**solve, "refinement": 1.25}
+
+
+def test_the_converged_contact_reaches_every_study_solve(tmp_path):
+    """workflow/overlays/converged_contact.yaml: its tip round and one-pass layer must reach the
+    solves and the convergence runs alike (a 1.25x run on sharp tips would not check the contact the
+    studies solve), and the default config must leave the solves' params as they were (no rerun of
+    a finished study)."""
+    import json
+
+    from hdwf.stages.fe_solve import DesignJob
+
+    copy_workflow(tmp_path)
+    runs = {}
+    for overlay in ("workflow/overlays/converged_contact.yaml", "workflow/overlays/hd42_only.yaml"):
+        run = subprocess.run([sys.executable, "-c", _MESH_PARAMS, str(tmp_path), overlay],
+                             capture_output=True, text=True, timeout=120)
+        assert run.returncode == 0, run.stderr[-3000:]
+        runs[overlay] = json.loads(run.stdout.strip().splitlines()[-1])
+    solve, refined = runs["workflow/overlays/converged_contact.yaml"]
+    assert solve == {"elements_over_height": 10, "elements_over_thickness": 6, "refinement": 1.0,
+                     "symmetry": "half", "flank_refinement": 2.5, "tip_round_m": 0.1,
+                     "flank_layer_fs_pass_only": True}
+    assert refined == {**solve, "refinement": 1.25}
+    default_solve, _ = runs["workflow/overlays/hd42_only.yaml"]
+    assert set(default_solve) == {"elements_over_height", "elements_over_thickness", "refinement", "symmetry",
+                                  "flank_refinement"}
+    table = tmp_path / "designs.parquet"
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+    pq.write_table(pa.table({"design_id": ["a"], "d_mm": [31.0], "D_mm": [42.0], "Gr_mm": [0.015],
+                             "rFS_mm": [0.0], "rCS_mm": [0.0]}), table)
+    effects = {"preload": {"interference_m": 0.3}, "flank_layer": {"thickness_m": 3800.0}}
+    _, changes, geom = DesignJob(table, "a", "hd42", solve, 5, effects).model()
+    assert (changes.flank_layer_fs_pass_only, geom.tip_round_m, geom.interference_m) == (True, 0.1, 0.3)
+    _, changes, geom = DesignJob(table, "a", "hd42", default_solve, 5, effects).model()
+    assert (changes.flank_layer_fs_pass_only, geom.tip_round_m) == (False, 0.0)

@@ -16,6 +16,8 @@ FE = config["fe"]
 # how the FE studies mesh a section (MeshSettings); the convergence runs change the refinement only
 FE_MESH = {k: FE[k] for k in ("elements_over_height", "elements_over_thickness", "refinement", "symmetry",
                               "flank_refinement")}
+# the tooth contact's options (DesignJob), only when set: the default studies' params stay as they were
+FE_MESH.update({k: FE[k] for k in ("tip_round_m", "flank_layer_fs_pass_only") if FE.get(k)})
 CAMPAIGNS = {name: campaign_plan(name, c, FE) for name, c in config.get("validation", {}).items()}
 
 

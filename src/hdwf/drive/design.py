@@ -66,7 +66,7 @@ def geometry_of(unit: str, params: Mapping[str, float], interference_m: float = 
                 tip_relief: float = 0.0, **shape) -> DriveGeometry:
     """The drive geometry of ``unit`` at the design parameters ``params`` (keys ``d_mm`` …), with
     the preloaded engagement and tip relief of ``drive_geometry`` (default: none); ``shape``
-    passes ``deflection_coeff``, ``addendum_frac`` and ``offset_direction`` on."""
+    passes ``tip_round_m``, ``deflection_coeff``, ``addendum_frac`` and ``offset_direction`` on."""
     return drive_geometry(unit, params["d_mm"], params["D_mm"], params["Gr_mm"], params["rFS_mm"], params["rCS_mm"],
                           interference_m=interference_m, tip_relief=tip_relief, **shape)
 

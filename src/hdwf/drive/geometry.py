@@ -232,6 +232,8 @@ class DriveGeometry:
     # compliance of a layer on the flanks (um of approach per MPa of contact pressure, 0 = none):
     # the 3D cup's compliance under each tooth, spread over the flank (``contact_rows``)
     flank_layer_um_per_MPa: float = 0.0
+    # the layer integrated along the FS outline alone (one contact pass; ``contact_rows``)
+    flank_layer_fs_pass_only: bool = False
 
     # ---- derived quantities -------------------------------------------------------
     @property

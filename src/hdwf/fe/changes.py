@@ -49,6 +49,12 @@ class ModelChanges:
       pressure), in series with every tooth pair over its share of the flank (``contact_rows``).
       It stands for compliance under each tooth that a plane section lacks (the 3D cup and
       face); the mesh is unchanged, the solve carries it (``DriveGeometry.flank_layer_um_per_MPa``).
+    * ``flank_layer_fs_pass_only``: how the layer is solved, not a physical addition: its overlap
+      integrated along the FS outline alone (the FS nodes against the CS segments, each overlap
+      counted once) instead of both passes (the CS tip pass counts the overlap at a CS tip corner
+      again).  With the tip corners rounded and 25 segments a flank it converges with the mesh on
+      every design tried, at about three times the solve (docs/fe-model.md, "Mesh convergence";
+      ``workflow/overlays/converged_contact.yaml``).
     * ``coning_slope``: the FS cup's coning c = b / z_0: the wave generator's push grows as
       w0 (1 + c zeta) across the face width (zeta = 0 at the diaphragm end), solved as
       ``coning_slices`` sections in parallel on one twist (``hdwf.fe.coning``; 0 = the uniform
@@ -63,6 +69,7 @@ class ModelChanges:
     output_microslip_loop_rad: float = 0.0
     flank_interference_m: float = 0.0
     flank_layer_m: float = 0.0
+    flank_layer_fs_pass_only: bool = False
     coning_slope: float = 0.0
     coning_slices: int = 8
 

@@ -342,7 +342,10 @@ def tooth_rows(structure: Structure, geom: DriveGeometry, u_watch: np.ndarray, c
 
     Two passes: every FS tooth-boundary node against the CS tooth segments, and the CS
     tip-land nodes (tip corners included) against the FS tooth segments: one pass alone
-    would let a CS tip corner sink into an FS flank between two FS nodes.  A node beyond
+    would let a CS tip corner sink into an FS flank between two FS nodes.  A flank layer solved
+    on the FS pass alone (``DriveGeometry.flank_layer_fs_pass_only``) has the first pass only:
+    its overlap is integrated along the FS outline, which meets every overlap, and a tip corner
+    sinking in is the layer's own compliance.  A node beyond
     the end of its closest segment gets its distance to the corner as its gap
     (``closest_segments``).
 
@@ -373,6 +376,8 @@ def tooth_rows(structure: Structure, geom: DriveGeometry, u_watch: np.ndarray, c
         # a rounded tip's nodes lie within about 0.6 of its radius of the tip circle
         tip_band = geom.r_cs_tip + max(CS_TIP_BAND * (geom.r_cs_root - geom.r_cs_tip), geom.tip_round)
         sn_cs = cs.independent(cn[r_cn <= tip_band])
+        if geom.flank_layer_um_per_MPa > 0 and geom.flank_layer_fs_pass_only:
+            sn_cs = sn_cs[:0]
     else:
         sn_fs, sn_cs = nodes
     fs_pass = _node_to_segment(fs, sn_fs, cs, "cs_teeth", u_watch, cand_gap)

@@ -59,10 +59,12 @@ def _watch_nodes(bms: dict[str, BodyMesh], zone_deg: float) -> dict[str, np.ndar
 
 
 def with_flank_layer(geom: DriveGeometry, changes: ModelChanges) -> DriveGeometry:
-    """``geom`` carrying the flank layer of ``changes``; ``geom`` as it is when they have none."""
+    """``geom`` carrying the flank layer of ``changes`` and how it is solved; ``geom`` as it is
+    when they have none."""
     if changes.flank_layer_m == 0:
         return geom
-    return replace(geom, flank_layer_um_per_MPa=changes.layer_um_per_MPa(geom.module, geom.E))
+    return replace(geom, flank_layer_um_per_MPa=changes.layer_um_per_MPa(geom.module, geom.E),
+                   flank_layer_fs_pass_only=changes.flank_layer_fs_pass_only)
 
 
 @dataclass

@@ -85,13 +85,16 @@ class CampaignArtefacts:
 @dataclass(frozen=True)
 class FeSettings:
     """The FE settings the report quotes (config ``fe``): the default mesh, the load steps, the
-    effects switched on in the FE studies (``{name: {parameter: value}}``) and the drive whose
-    data set their values (the other drive's agreement is then a blind prediction)."""
+    effects switched on in the FE studies (``{name: {parameter: value}}``), the drive whose
+    data set their values (the other drive's agreement is then a blind prediction) and the tooth
+    contact's options (``fe.tip_round_m``, ``fe.flank_layer_fs_pass_only``)."""
 
     mesh: MeshSettings
     steps_per_ramp: int
     effects: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     calibrated_on: str | None = None
+    tip_round_m: float = 0.0
+    flank_layer_fs_pass_only: bool = False
 
 
 @dataclass(frozen=True)

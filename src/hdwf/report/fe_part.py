@@ -69,6 +69,9 @@ def fe_model_section(doc: Document, assumptions: tuple[dict, ...], pictures: dic
              + (f", every flank divided into {mesh.flank_refinement:g} times as many segments "
                 f"({mesh.segments_per_flank} a flank, `fe.flank_refinement`)"
                 if mesh.flank_refinement != 1 else "")
+             + (f", the tip corners rounded {settings.tip_round_m:g} m (`fe.tip_round_m`)" if settings.tip_round_m else "")
+             + (", the flank layer integrated along the FS outline alone (one contact pass, "
+                "`fe.flank_layer_fs_pass_only`)" if settings.flank_layer_fs_pass_only else "")
              + f"; {settings.steps_per_ramp} load steps per ramp; "
              + ("the half model (angles 0 to π tied by the drive's 180° point symmetry, which reproduces the "
                 "full model's $Phi$ within 0.05 %, `docs/fe-model.md`)." if mesh.symmetry == "half"

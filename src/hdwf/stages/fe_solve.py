@@ -8,7 +8,7 @@ tables and never import pandas, which would add a quarter of a second to each on
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Mapping
 
@@ -22,7 +22,9 @@ from hdwf.validation.effects import model_changes
 @dataclass(frozen=True)
 class DesignJob:
     """One design of a study to mesh and solve: where its parameters are, the study's mesh and load
-    steps, and the effects switched on in the study's model (``fe.effects``)."""
+    steps, and the effects switched on in the study's model (``fe.effects``).  ``settings`` also
+    carries the tooth contact's options, if set: ``tip_round_m`` (the tip corners' round, units of m)
+    and ``flank_layer_fs_pass_only`` (``ModelChanges.flank_layer_fs_pass_only``)."""
     designs_path: str | Path
     design_id: str
     unit: str
@@ -34,8 +36,11 @@ class DesignJob:
         """The design's parameters, the switched-on changes and the geometry they shape (the preload
         thickens the teeth)."""
         params = design_parameters(self.designs_path, self.design_id)
-        changes = model_changes(self.effects)
-        return params, changes, geometry_of(self.unit, params, **changes.geometry_part())
+        changes = replace(model_changes(self.effects),
+                          flank_layer_fs_pass_only=bool(self.settings.get("flank_layer_fs_pass_only", False)))
+        geom = geometry_of(self.unit, params, **changes.geometry_part(),
+                           tip_round_m=float(self.settings.get("tip_round_m", 0.0)))
+        return params, changes, geom
 
     def mesh(self, geom, path: str | None = None) -> DriveMesh:
         """The design's mesh at the job's settings (gmsh's ``.msh`` written to ``path`` if given)."""

@@ -113,6 +113,8 @@ def full_report_stage(studies: Mapping[str, Mapping], fe: Mapping, inputs: Mappi
         studies=tuple(study_artefacts(name, cfg, grouped) for name, cfg in studies.items()),
         campaigns=campaigns, data_dir=Path(data_dir),
         fe_settings=FeSettings(mesh=MeshSettings.from_mapping(fe), steps_per_ramp=fe["steps_per_ramp"],
-                               effects=fe.get("effects", {}), calibrated_on=fe.get("calibrated_on")),
+                               effects=fe.get("effects", {}), calibrated_on=fe.get("calibrated_on"),
+                               tip_round_m=float(fe.get("tip_round_m", 0.0)),
+                               flank_layer_fs_pass_only=bool(fe.get("flank_layer_fs_pass_only", False))),
         assumptions=tuple(assumptions_table()), provenance=provenance)
     return full_report(report, out)
