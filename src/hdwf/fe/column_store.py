@@ -124,10 +124,12 @@ class ColumnStore:
         G = sp.csr_matrix(G)
         # each watch entry read once, though neighbouring rows share nodes
         watched, entry = np.unique(G.indices, return_inverse=True)
-        parts = []
+        compact = sp.csr_matrix((G.data, entry, G.indptr), shape=(G.shape[0], watched.size))
+        out = np.zeros((G.shape[0], max(n - start, 0)))
+        # chunk by chunk: the entries of all columns at once were the solve's peak memory (two
+        # copies of most of the store on a finely divided flank)
         for c in range(start // CHUNK_ROWS, -(-n // CHUNK_ROWS)):
             lo, hi = max(start, c * CHUNK_ROWS), min(n, (c + 1) * CHUNK_ROWS)
-            parts.append(self._chunks[c][lo - c * CHUNK_ROWS:hi - c * CHUNK_ROWS][:, watched])
-        touched = np.vstack(parts) if parts else np.zeros((0, watched.size))  # (n - start) x entries
-        compact = sp.csr_matrix((G.data, entry, G.indptr), shape=(G.shape[0], watched.size))
-        return np.asarray(compact @ np.ascontiguousarray(touched.T))
+            touched = self._chunks[c][lo - c * CHUNK_ROWS:hi - c * CHUNK_ROWS][:, watched]  # columns x entries
+            out[:, lo - start:hi - start] = compact @ np.ascontiguousarray(touched.T)
+        return out
