@@ -9,15 +9,16 @@ from hdwf.drive.geometry import drive_geometry
 from hdwf.drive.mesh import build_mesh
 from hdwf.fe import LostMotionModel
 from hdwf.fe.bodies import Body
+from hdwf.fe.model import ZONE_DEG
 
 
 @lru_cache(maxsize=None)
-def _structure(symmetry="half", rings=False):
-    """A coarse HD 42 structure; with ``rings`` False its tooth bodies keep plain
-    ``NodeColumns`` (no turns by periods)."""
+def _structure(symmetry="half", rings=False, zone_deg=ZONE_DEG):
+    """A coarse HD 42 structure, its teeth watched within ``zone_deg`` of the major axes; with
+    ``rings`` False its tooth bodies keep plain ``NodeColumns`` (no turns by periods)."""
     g = drive_geometry("hd42", 31.0, 42.0, 0.015, 0.005, 0.005)
     mesh = build_mesh(g, elements_over_height=6, elements_over_thickness=4, symmetry=symmetry)
-    structure = LostMotionModel(g, mesh).structure
+    structure = LostMotionModel(g, mesh, zone_deg=zone_deg).structure
     if not rings:
         structure.plain_node_columns()
     return structure

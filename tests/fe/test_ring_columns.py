@@ -5,6 +5,7 @@ import pytest
 import scipy.sparse as sp
 
 from hdwf.fe.bodies import Body
+from hdwf.fe.model import ZONE_DEG
 from hdwf.fe.ring_columns import RingColumns, RingTurns
 
 from tests.fe.test_node_columns import _direct, _structure
@@ -81,6 +82,38 @@ def test_turned_columns_equal_direct_back_substitution(symmetry, monkeypatch):
         Xd, Xqd = _direct(structure, G)
         assert np.abs(X - Xd).max() <= TOL * np.abs(Xd).max()
         assert np.abs(Xq - Xqd).max() <= TOL * np.abs(Xqd).max()
+
+
+@pytest.mark.parametrize("zone_deg, periods", [(ZONE_DEG, (3, 9)), (90.0, (5, 40, 70))])
+def test_responses_are_kept_where_a_turn_reads_them(zone_deg, periods):
+    """With every tooth watched (a preload's 90 degree zones) a turn reads a watch node's response
+    from another watch node, so the base responses are kept at the watch nodes (and the FS pin's
+    turned places) only, a fraction of the body's nodes; with the teeth watched in zones a turn
+    reads from outside them, so every node is kept.  Either way a row on any watched tooth answers
+    as its direct back-substitution."""
+    structure = _structure("half", rings=True, zone_deg=zone_deg)
+    rows = []
+    for name, angle in (("fs", 0.4), ("cs", 0.4 + np.pi)):
+        b, ring = structure.bodies[name], structure.node_columns(name)
+        assert type(ring) is RingColumns
+        kept = np.flatnonzero(ring._rows[0] >= 0)
+        n_nodes = b.dofs.shape[1]
+        if zone_deg == ZONE_DEG:
+            assert kept.size == n_nodes
+        else:
+            assert np.isin(b.watch_nodes, kept).all()
+            assert kept.size <= b.watch_nodes.size + ring.turns.periods * ring._pin_nodes.size
+            assert kept.size < 0.3 * n_nodes
+        node0 = _near_major_axis(b)
+        rows.append((name, [node0], [1.0], angle))
+        for p in periods:
+            a = 2 * np.pi * p / structure.teeth[name]
+            rows.append((name, [_same_node_turned(b, structure.teeth[name], node0, p)], [1.0], angle + a))
+    G = _tooth_rows(structure, rows)
+    X, Xq = structure.compliance_columns(G)
+    Xd, Xqd = _direct(structure, G)
+    assert np.abs(X - Xd).max() <= TOL * np.abs(Xd).max()
+    assert np.abs(Xq - Xqd).max() <= TOL * np.abs(Xqd).max()
 
 
 def test_turns_make_a_group_that_closes_after_a_full_turn():

@@ -76,8 +76,10 @@ class RingTurns:
         if dist.max() > MAP_TOL * scale:
             raise ValueError(f"the mesh is not periodic with {teeth} teeth: a node turned by one "
                              f"period is {dist.max():.3g} mm from the nearest node")
-        self._source = [np.arange(x.shape[1]), src]
-        self._sign = [np.ones(x.shape[1]), sign]
+        # a map for every turn is kept (a solve turns by most of them), in the narrowest types
+        # that hold it: a quarter of the memory of int64 and float64 maps
+        self._source = [np.arange(x.shape[1], dtype=np.int32), src.astype(np.int32)]
+        self._sign = [np.ones(x.shape[1], dtype=np.int8), sign.astype(np.int8)]
         angle = np.mod(np.arctan2(x[1], x[0]), 2.0 * math.pi)
         if half:
             angle = np.where(angle > 1.5 * math.pi, 0.0, angle)   # -0.0 rounding at the cut
@@ -131,8 +133,6 @@ class RingColumns:
         self.turns = turns
         nd = body.dofs
         self._twist_response = twist_response
-        # G f0 of every base pattern (full body dofs x patterns; grows by doubling)
-        self._responses = np.zeros((nd.size, 0))
         self._size = 0
         self.patterns: dict[tuple[int, ...], list[tuple[np.ndarray, int]]] = {}
         names = sorted(body.modes)
@@ -145,6 +145,11 @@ class RingColumns:
         pin_at = [np.argwhere(nd == d)[0] for d in self._pinned]     # (component, node) each
         self._pin_components = np.array([c for c, _ in pin_at], dtype=np.int64)
         self._pin_nodes = np.array([n for _, n in pin_at], dtype=np.int64)
+        # G f0 of every base pattern, kept only at the nodes a turn reads it from: the watch nodes
+        # (a turn maps them onto each other) and the pins' sources; 2 rows a node (x, then y,
+        # ``_rows``); patterns grow by doubling
+        self._rows = self._kept_rows()
+        self._responses = np.zeros((int((self._rows >= 0).sum()), 0))
         if self._R.shape[1]:
             WR = self._w[:, None] * self._R
             self._RWR_inv = np.linalg.inv(self._R.T @ WR)
@@ -182,6 +187,25 @@ class RingColumns:
         tie = b.tie.tocsc()
         return np.array([tie.indices[tie.indptr[j]] for j in pinned_reduced])
 
+    def _kept_rows(self) -> np.ndarray:
+        """Row of the kept responses for each (component, node), -1 where none is kept (2, n).
+
+        A turn reads a watch node's value from another watch node when the watch nodes are the
+        same on every period (every tooth watched); otherwise every node is kept."""
+        n = self.body.dofs.shape[1]
+        wn = self.body.watch_nodes
+        kept = np.zeros(n, dtype=bool)
+        kept[wn] = True
+        if not kept[self.turns.source(1)[wn]].all():
+            kept[:] = True
+        for p in range(self.turns.periods):
+            kept[self.turns.source(p)[self._pin_nodes]] = True
+        nodes = np.flatnonzero(kept)
+        rows = np.full((2, n), -1, dtype=np.int64)
+        rows[0, nodes] = 2 * np.arange(nodes.size)
+        rows[1, nodes] = rows[0, nodes] + 1
+        return rows
+
     def _generalized(self, F: np.ndarray) -> np.ndarray:
         """G F: the response that commutes with the turns (A F for a body without modes)."""
         if not self._R.shape[1]:
@@ -191,12 +215,13 @@ class RingColumns:
         return U - self._R @ (self._RWR_inv @ (self._R.T @ (self._w[:, None] * U)))
 
     def _turn(self, U: np.ndarray, p: int, nodes: np.ndarray, cols: np.ndarray | None = None,
-              right: np.ndarray | None = None) -> np.ndarray:
+              right: np.ndarray | None = None, kept: bool = False) -> np.ndarray:
         """(S_p U) at ``nodes`` (n), x then y: (2, n) or (2, n, k); of U's columns ``cols`` only
         if given (gathered without copying the rest), times ``right`` if given (the turn acts
-        node by node, so it commutes with combining columns: the fewer combined ones are turned)."""
+        node by node, so it commutes with combining columns: the fewer combined ones are turned).
+        U holds body dofs, or with ``kept`` the kept responses' rows (``_kept_rows``)."""
         src, sgn = self.turns.source(p)[nodes], self.turns.sign(p)[nodes]
-        nd = self.body.dofs
+        nd = self._rows if kept else self.body.dofs
         if cols is None:
             ux, uy = U[nd[0, src]], U[nd[1, src]]
         else:
@@ -291,7 +316,10 @@ class RingColumns:
         F = np.zeros((b.stiffness.shape[0], len(loads)))
         for j, (dofs, values) in enumerate(loads):
             F[b.dofs[dofs % 2, dofs // 2], j] = values
-        U = self._generalized(F)
+        full = self._generalized(F)
+        U = np.empty((self._responses.shape[0], full.shape[1]))
+        kept = self._rows[0] >= 0
+        U[self._rows[0, kept]], U[self._rows[1, kept]] = full[b.dofs[0, kept]], full[b.dofs[1, kept]]
         if self._size + U.shape[1] > self._responses.shape[1]:
             grown = np.zeros((U.shape[0], max(2 * self._responses.shape[1], self._size + U.shape[1], 64)))
             grown[:, :self._size] = self._responses[:, :self._size]
@@ -310,7 +338,7 @@ class RingColumns:
             for i, w in coef:
                 C[where[i], j] += w
         wn = self.body.watch_nodes
-        turned = self._turn(self._responses, p, wn, used, right=C)    # (2, n_watch, k)
+        turned = self._turn(self._responses, p, wn, used, right=C, kept=True)    # (2, n_watch, k)
         Uw = np.empty((2 * wn.size, len(coefs)))
         Uw[0::2], Uw[1::2] = turned[0], turned[1]
         twist = np.zeros(len(coefs))
@@ -318,7 +346,7 @@ class RingColumns:
             twist = np.array([self._twist_response[d] @ v for d, v in zip(loads_dofs, loads_vals)])
         if self._R.shape[1]:
             nd = self.body.dofs
-            at_pins = self._turn(self._responses, p, self._pin_nodes, used, right=C)   # (2, pins, k)
+            at_pins = self._turn(self._responses, p, self._pin_nodes, used, right=C, kept=True)   # (2, pins, k)
             pins_val = at_pins[self._pin_components, np.arange(self._pinned.size)]
             Rt = np.zeros((self._R.shape[1], len(coefs)))
             for j, (dofs, vals) in enumerate(zip(loads_dofs, loads_vals)):
